@@ -1,0 +1,24 @@
+"""collidium: particles in a 2D vessel with exact elastic collisions and Coulomb forces.
+
+>>> import collidium as cd
+>>> sim = cd.load("gas", n=500, seed=3)
+>>> sim.run(time=5.0).energy().total  # doctest: +SKIP
+"""
+
+from collidium.containers import Box
+from collidium.errors import InputError, SimulationError
+from collidium.forces import Coulomb
+from collidium.simulation import Counters, Energy, Simulation
+from collidium.state import Particles
+
+__all__ = [
+    "Box",
+    "Counters",
+    "Coulomb",
+    "Energy",
+    "InputError",
+    "Particles",
+    "Simulation",
+    "SimulationError",
+]
+__version__ = "0.1.0"

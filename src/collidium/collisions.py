@@ -1,0 +1,176 @@
+"""How particles move during the drift of a step, and how they collide.
+
+Three modes (DESIGN.md section 2):
+
+- `ExactCollisions` (``"exact"``): event-driven free flight with exact elastic pair and wall
+  collisions (`kernels/events.py`). Its event queue is kept between steps and rebuilt only when the
+  state was changed from outside (a force kick, a user edit).
+- `StepCollisions` (``"step"``): the seed's method: a plain drift, walls folded back exactly, then
+  overlapping approaching pairs resolved one by one in index order (`kernels/stepper.py`).
+- `NoCollisions` (``"off"``): disks pass through each other; walls still reflect exactly.
+
+Each mode moves ``particles`` from time ``now`` to ``now + dt`` in place and adds to ``tally``
+(int64, shape (5,)): pair collisions, then hits on the left, right, bottom and top wall.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, Protocol
+
+import numpy as np
+
+from collidium.containers import Box
+from collidium.kernels import events, stepper, walls
+from collidium.kernels.cells import grid_shape, neighbour_table
+from collidium.state import FloatArray, IntArray, Particles
+
+CollisionMode = Literal["exact", "step", "off"]
+COLLISION_MODES: tuple[CollisionMode, ...] = ("exact", "step", "off")
+
+
+class Drift(Protocol):
+    """A drift mode: moves particles over one step and counts collisions."""
+
+    def drift(self, particles: Particles, box: Box, now: float, dt: float, tally: IntArray) -> None:
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
+
+
+def make_drift(mode: CollisionMode) -> Drift:
+    """The drift object for a collision mode name."""
+    return {"exact": ExactCollisions, "step": StepCollisions, "off": NoCollisions}[mode]()
+
+
+class _Grid:
+    """Cell grid sized for the particles' largest diameter, with work arrays."""
+
+    def __init__(self, particles: Particles, box: Box) -> None:
+        n = particles.n
+        diameter = 2.0 * float(particles.radius.max(initial=0.0))
+        self.shape = grid_shape(box.width, box.height, diameter, n)
+        ncx, ncy = self.shape
+        self.cells, self.shifts = neighbour_table(ncx, ncy, box.periodic)
+        self.cell_of = np.empty(n, dtype=np.int64)
+        self.head = np.empty(ncx * ncy, dtype=np.int64)
+        self.next = np.empty(n, dtype=np.int64)
+        self.prev = np.empty(n, dtype=np.int64)
+
+
+def _free_flight(particles: Particles, box: Box, dt: float, tally: IntArray) -> None:
+    if box.periodic:
+        walls.drift_periodic(
+            particles.position, particles.velocity, particles.image, box.width, box.height, dt
+        )
+    else:
+        walls.drift_reflecting(
+            particles.position, particles.velocity, particles.radius,
+            0.5 * box.width, 0.5 * box.height, dt, tally[1:],
+        )  # fmt: skip
+
+
+class NoCollisions:
+    """Pass-through: free flight with exact wall reflection (or periodic wrapping)."""
+
+    def drift(self, particles: Particles, box: Box, now: float, dt: float, tally: IntArray) -> None:
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
+        _free_flight(particles, box, dt, tally)
+
+
+class StepCollisions:
+    """The seed's method: drift, fold back from walls, resolve overlapping pairs in index order.
+
+    A collision is only detected if the disks overlap at the end of a step, so fast or small disks
+    can pass through each other; energy is still conserved by each resolved collision.
+    """
+
+    def __init__(self) -> None:
+        self._grid: _Grid | None = None
+        self._pairs = np.empty(64, dtype=np.int64)
+
+    def drift(self, particles: Particles, box: Box, now: float, dt: float, tally: IntArray) -> None:
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
+        _free_flight(particles, box, dt, tally)
+        if self._grid is None or self._grid.cell_of.shape[0] != particles.n:
+            self._grid = _Grid(particles, box)
+        g = self._grid
+        while True:
+            count = stepper.overlapping_pairs(
+                particles.position, particles.radius, box.width, box.height, *g.shape,
+                g.cell_of, g.head, g.next, g.prev, g.cells, g.shifts, self._pairs,
+            )  # fmt: skip
+            if count <= self._pairs.shape[0]:
+                break
+            self._pairs = np.empty(2 * count, dtype=np.int64)
+        tally[0] += stepper.resolve_pairs(
+            self._pairs[:count], particles.position, particles.velocity, particles.mass,
+            box.width, box.height, box.periodic,
+        )  # fmt: skip
+
+
+class ExactCollisions:
+    """Event-driven drift: exact collision times and exact elastic responses.
+
+    The engine keeps lazily updated positions of its own; ``particles.position`` receives the
+    positions at the end of each drift. If the particles' positions or velocities differ from what
+    the engine last wrote (a force kick, an edit by the user), the queue is rebuilt from them.
+    """
+
+    def __init__(self) -> None:
+        self._state: dict[str, np.ndarray] | None = None
+        self._written: FloatArray | None = None  # positions last written to the particles
+        #: Events processed so far (collisions, wall hits, cell crossings, stale events).
+        self.events = 0
+
+    def _is_current(self, particles: Particles) -> bool:
+        return (
+            self._state is not None
+            and self._written is not None
+            and np.array_equal(self._written, particles.position)
+            and np.array_equal(self._state["velocity"], particles.velocity)
+        )
+
+    def _rebuild(self, particles: Particles, box: Box, now: float) -> dict[str, np.ndarray]:
+        n = particles.n
+        grid = _Grid(particles, box)
+        ncx, ncy = grid.shape
+        s = {
+            "position": particles.position.copy(),
+            "velocity": particles.velocity.copy(),
+            "stamp": np.empty(n),
+            "geometry": np.array(
+                [0.5 * box.width, 0.5 * box.height, box.width / ncx, box.height / ncy]
+            ),
+            "grid": np.array([ncx, ncy, int(box.periodic)], dtype=np.int64),
+            "cell_of": grid.cell_of, "head": grid.head, "next": grid.next, "prev": grid.prev,
+            "cells": grid.cells, "shifts": grid.shifts,
+            "collisions": np.zeros(n, dtype=np.int64),
+            "event_time": np.empty(n),
+            "event_kind": np.empty(n, dtype=np.int64),
+            "event_other": np.empty(n, dtype=np.int64),
+            "event_stamp": np.empty(n, dtype=np.int64),
+            "heap": np.empty(n, dtype=np.int64),
+            "heap_where": np.empty(n, dtype=np.int64),
+        }  # fmt: skip
+        events.rebuild(
+            now, s["position"], s["velocity"], s["stamp"], particles.radius, s["geometry"],
+            s["grid"], s["cell_of"], s["head"], s["next"], s["prev"], s["cells"], s["shifts"],
+            s["collisions"], s["event_time"], s["event_kind"], s["event_other"],
+            s["event_stamp"], s["heap"], s["heap_where"],
+        )  # fmt: skip
+        return s
+
+    def drift(self, particles: Particles, box: Box, now: float, dt: float, tally: IntArray) -> None:
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
+        if not self._is_current(particles):
+            self._state = self._rebuild(particles, box, now)
+        s = self._state
+        assert s is not None
+        until = now + dt
+        self.events += events.run_events(
+            until, s["position"], s["velocity"], s["stamp"], particles.mass, particles.radius,
+            particles.image, s["geometry"], s["grid"], s["cell_of"], s["head"], s["next"],
+            s["prev"], s["cells"], s["shifts"], s["collisions"], s["event_time"],
+            s["event_kind"], s["event_other"], s["event_stamp"], s["heap"], s["heap_where"], tally,
+        )  # fmt: skip
+        events.synchronise(until, s["position"], s["velocity"], s["stamp"], particles.position)
+        particles.velocity[...] = s["velocity"]
+        self._written = particles.position.copy()

@@ -1,0 +1,117 @@
+"""Vessels. `Box`: a rectangle centred on the origin, reflecting or periodic.
+
+The geometry lives here; the fast time-of-impact and reflection arithmetic used inside a run is in
+`kernels/walls.py` (and the event engine), which take the half sizes this class provides.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+
+from collidium.errors import InputError
+from collidium.state import FloatArray
+
+Boundary = Literal["reflecting", "periodic"]
+BOUNDARIES: tuple[Boundary, ...] = ("reflecting", "periodic")
+
+#: Relative round-off allowance when deciding that a disk pokes out of a reflecting box.
+OUTSIDE_TOLERANCE = 1e-9
+
+
+class Box:
+    """Rectangle ``[-width/2, width/2] x [-height/2, height/2]`` in m.
+
+    Parameters
+    ----------
+    width, height : float
+        Side lengths in m, > 0.
+    boundary : {"reflecting", "periodic"}
+        ``"reflecting"``: walls reflect disks elastically at the exact time of impact (a disk of
+        radius r touches a wall when its centre is r away from it). ``"periodic"``: positions wrap,
+        pairs and forces use the minimum image, unwrapped displacements are kept in
+        ``Particles.image``.
+    """
+
+    def __init__(self, width: float, height: float, boundary: Boundary = "reflecting") -> None:
+        for name, value in (("width", width), ("height", height)):
+            if not np.isfinite(value) or value <= 0:
+                raise InputError(f"box.{name}", f"must be a finite number > 0, got {value!r}")
+        if boundary not in BOUNDARIES:
+            raise InputError("box.boundary", f"must be one of {BOUNDARIES}, got {boundary!r}")
+        self.width = float(width)
+        self.height = float(height)
+        self.boundary: Boundary = boundary
+
+    @property
+    def periodic(self) -> bool:
+        """True for a periodic box."""
+        return self.boundary == "periodic"
+
+    @property
+    def size(self) -> FloatArray:
+        """``(width, height)`` in m, shape (2,)."""
+        return np.array([self.width, self.height])
+
+    @property
+    def area(self) -> float:
+        """Area in m^2."""
+        return self.width * self.height
+
+    def outside(self, position: FloatArray, radius: FloatArray) -> FloatArray:
+        """Indices of particles not inside the vessel.
+
+        Parameters
+        ----------
+        position : ndarray, shape (N, 2)
+            Centres in m.
+        radius : ndarray, shape (N,)
+            Radii in m.
+
+        Returns
+        -------
+        ndarray of int, shape (M,)
+            Reflecting box: disks that reach past a wall by more than round-off. Periodic box:
+            centres outside the primary cell ``[-L/2, L/2]``.
+        """
+        half = 0.5 * self.size
+        if self.periodic:
+            reach = np.abs(position) - half
+        else:
+            reach = np.abs(position) + radius[:, None] - half
+        bad = (reach > OUTSIDE_TOLERANCE * half).any(axis=1) | ~np.isfinite(position).all(axis=1)
+        return np.flatnonzero(bad)
+
+    def check_fits(self, radius: FloatArray) -> None:
+        """Refuse disks too large for the box (periodic: a diameter of at most half a side, so a
+        disk never touches two images of another and the minimum image is the one in contact)."""
+        if radius.size == 0:
+            return
+        r = float(radius.max())
+        limit = min(self.width, self.height)
+        if self.periodic and 4 * r > limit:
+            raise InputError("radius", f"diameter {2 * r} too large for a periodic box of side {limit}")
+        if 2 * r > limit:
+            raise InputError("radius", f"diameter {2 * r} does not fit in a box of side {limit}")
+
+    def wrap(self, position: FloatArray) -> FloatArray:
+        """Positions mapped into the primary cell (periodic); unchanged copy otherwise."""
+        if not self.periodic:
+            return position.copy()
+        size = self.size
+        return position - size * np.floor((position + 0.5 * size) / size)
+
+    def minimum_image(self, displacement: FloatArray) -> FloatArray:
+        """Shortest periodic image of displacements ``(..., 2)``; unchanged otherwise."""
+        if not self.periodic:
+            return displacement
+        size = self.size
+        return displacement - size * np.round(displacement / size)
+
+    def to_dict(self) -> dict[str, object]:
+        """Plain parameters, as in a scenario file."""
+        return {"width": self.width, "height": self.height, "boundary": self.boundary}
+
+    def __repr__(self) -> str:
+        return f"Box({self.width!r}, {self.height!r}, boundary={self.boundary!r})"

@@ -1,0 +1,129 @@
+"""Forces between particles. `Coulomb`: seed eq. 9-10 with optional softening and the seed's
+acceleration limiter."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from collidium.containers import Box
+from collidium.errors import InputError
+from collidium.kernels.pairwise import coulomb_direct
+from collidium.state import FloatArray, Particles
+
+
+@dataclass(frozen=True)
+class Coulomb:
+    """Coulomb interaction ``F = k q_i q_j r / (r^2 + eps^2)^(3/2)``, ``U = k q_i q_j / sqrt(r^2 + eps^2)``.
+
+    Parameters
+    ----------
+    k : float
+        Coulomb constant in N m^2 / C^2 (the seed uses 5).
+    softening : float
+        Softening length eps in m (>= 0); keeps the force finite for point particles.
+    max_acceleration : float or None
+        The seed's limiter: accelerations are capped smoothly,
+        ``a -> a / sqrt(1 + (|a| / a_max)^2)``. Not energy conserving (seed 4.2); None to disable.
+
+    Notes
+    -----
+    Direct summation in a parallel numba kernel, O(N^2). In a periodic box the minimum image is
+    used (an approximation until Ewald summation exists).
+    """
+
+    k: float = 5.0
+    softening: float = 0.0
+    max_acceleration: float | None = None
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.k):
+            raise InputError("forces.coulomb.k", f"must be finite, got {self.k!r}")
+        if not math.isfinite(self.softening) or self.softening < 0:
+            raise InputError("forces.coulomb.softening", f"must be >= 0, got {self.softening!r}")
+        cap = self.max_acceleration
+        if cap is not None and (not math.isfinite(cap) or cap <= 0):
+            raise InputError("forces.coulomb.max_acceleration", f"must be > 0, got {cap!r}")
+
+    def compute(self, particles: Particles, box: Box, force: FloatArray, energy: FloatArray) -> None:
+        """Write this force on each particle into ``force`` (N, 2), in N, and each particle's share
+        of the pair energy into ``energy`` (N,), in J (their sum is the potential energy)."""
+        coulomb_direct(
+            particles.position, particles.charge, self.k, self.softening**2,
+            box.width, box.height, box.periodic, force, energy,
+        )  # fmt: skip
+
+    def limit(self, acceleration: FloatArray) -> None:
+        """Apply the smooth acceleration cap in place (no-op without ``max_acceleration``)."""
+        if self.max_acceleration is None:
+            return
+        magnitude = np.hypot(acceleration[:, 0], acceleration[:, 1])
+        acceleration /= np.sqrt(1.0 + (magnitude / self.max_acceleration) ** 2)[:, None]
+
+    def to_dict(self) -> dict[str, object]:
+        """Parameters as in a scenario file (None omitted)."""
+        out: dict[str, object] = {"type": "coulomb", "k": self.k, "softening": self.softening}
+        if self.max_acceleration is not None:
+            out["max_acceleration"] = self.max_acceleration
+        return out
+
+
+
+class ForceField:
+    """All forces of a simulation: total acceleration and potential energy, with reused buffers.
+
+    Parameters
+    ----------
+    forces : sequence of Coulomb
+        The forces acting; empty for free flight.
+    """
+
+    def __init__(self, forces: tuple[Coulomb, ...]) -> None:
+        self.forces = tuple(forces)
+        self._force = np.empty((0, 2))
+        self._energy = np.empty(0)
+        self._evaluated_at: FloatArray | None = None
+        self._acceleration = np.empty((0, 2))
+        self._potential = 0.0
+
+    @property
+    def acceleration(self) -> FloatArray:
+        """Acceleration (N, 2) in m/s^2 from the last `evaluate`."""
+        return self._acceleration
+
+    @property
+    def active(self) -> bool:
+        """True when at least one force acts."""
+        return bool(self.forces)
+
+    def evaluate(self, particles: Particles, box: Box) -> FloatArray:
+        """Total acceleration (N, 2) in m/s^2 at the current positions; also caches the potential.
+
+        Each force's limiter (if any) applies to that force's own acceleration.
+        """
+        n = particles.n
+        if self._force.shape[0] != n:
+            self._force = np.empty((n, 2))
+            self._energy = np.empty(n)
+            self._acceleration = np.empty((n, 2))
+        self._acceleration[...] = 0.0
+        potential = 0.0
+        for force in self.forces:
+            force.compute(particles, box, self._force, self._energy)
+            contribution = self._force / particles.mass[:, None]
+            force.limit(contribution)
+            self._acceleration += contribution
+            potential += float(np.sum(self._energy))
+        self._potential = potential
+        self._evaluated_at = particles.position.copy()
+        return self._acceleration
+
+    def potential(self, particles: Particles, box: Box) -> float:
+        """Potential energy in J at the current positions (cached from the last evaluation)."""
+        if not self.active:
+            return 0.0
+        if self._evaluated_at is None or not np.array_equal(self._evaluated_at, particles.position):
+            self.evaluate(particles, box)
+        return self._potential

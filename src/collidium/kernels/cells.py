@@ -1,0 +1,165 @@
+"""Uniform cell grid over the box: linked lists of particles per cell, neighbour table, overlaps.
+
+Cells are at least one largest diameter wide, so two disks in contact always sit in the same or
+adjacent cells. Radius-0 particles are kept out of the grid (they never collide with each other or
+with disks).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+
+@numba.njit(cache=True)
+def neighbour_table(ncx: int, ncy: int, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The 9 cells around each cell (itself included) and the periodic shift to reach each.
+
+    Returns
+    -------
+    cells : ndarray of int64, shape (ncx * ncy, 9)
+        Row ``c`` lists the cells adjacent to cell ``c = cx + ncx * cy``; -1 past a reflecting wall.
+    shifts : ndarray of int64, shape (ncx * ncy, 9, 2)
+        For a periodic box, the whole box lengths to add to a neighbour's position to get the
+        image adjacent to cell ``c``. In a grid of one or two cells the same cell appears under
+        several shifts, so every image within reach is considered.
+    """
+    cells = np.full((ncx * ncy, 9), -1, dtype=np.int64)
+    shifts = np.zeros((ncx * ncy, 9, 2), dtype=np.int64)
+    for cy in range(ncy):
+        for cx in range(ncx):
+            c = cx + ncx * cy
+            k = 0
+            for oy in range(-1, 2):
+                for ox in range(-1, 2):
+                    nx = cx + ox
+                    ny = cy + oy
+                    if periodic:
+                        shifts[c, k, 0] = (nx - nx % ncx) // ncx
+                        shifts[c, k, 1] = (ny - ny % ncy) // ncy
+                        cells[c, k] = nx % ncx + ncx * (ny % ncy)
+                    elif 0 <= nx < ncx and 0 <= ny < ncy:
+                        cells[c, k] = nx + ncx * ny
+                    k += 1
+    return cells, shifts
+
+
+@numba.njit(cache=True, inline="always")
+def cell_index(x: float, half: float, cell: float, count: int) -> int:
+    """Index along one axis of the cell holding coordinate ``x`` (clamped to the grid)."""
+    k = int(math.floor((x + half) / cell))
+    return min(max(k, 0), count - 1)
+
+
+@numba.njit(cache=True)
+def fill_cells(
+    position: np.ndarray,
+    radius: np.ndarray,
+    half_width: float,
+    half_height: float,
+    ncx: int,
+    ncy: int,
+    cell_of: np.ndarray,
+    head: np.ndarray,
+    next_: np.ndarray,
+    prev: np.ndarray,
+) -> None:
+    """Put every particle with radius > 0 in its cell's doubly linked list.
+
+    Parameters
+    ----------
+    position : ndarray, shape (N, 2)
+        Centres in m (inside the box).
+    radius : ndarray, shape (N,)
+        Radii in m; radius-0 particles get ``cell_of = -1``.
+    half_width, half_height : float
+        Half sides of the box in m.
+    ncx, ncy : int
+        Cells along x and y.
+    cell_of, head, next_, prev : ndarray of int64
+        Outputs: cell of each particle (N,), first particle of each cell (ncx*ncy,), and the
+        next/previous particle in the same cell (N,); -1 ends a list.
+    """
+    cw = 2.0 * half_width / ncx
+    ch = 2.0 * half_height / ncy
+    head[:] = -1
+    # Insert in reverse index order so each list reads in increasing index order.
+    for i in range(position.shape[0] - 1, -1, -1):
+        next_[i] = -1
+        prev[i] = -1
+        if radius[i] <= 0.0:
+            cell_of[i] = -1
+            continue
+        c = cell_index(position[i, 0], half_width, cw, ncx) + ncx * cell_index(
+            position[i, 1], half_height, ch, ncy
+        )
+        cell_of[i] = c
+        first = head[c]
+        next_[i] = first
+        if first >= 0:
+            prev[first] = i
+        head[c] = i
+
+
+@numba.njit(cache=True)
+def first_overlap(
+    position: np.ndarray,
+    radius: np.ndarray,
+    width: float,
+    height: float,
+    periodic: bool,
+    ncx: int,
+    ncy: int,
+) -> tuple[int, int]:
+    """The overlapping pair ``(i, j)``, i < j, with the smallest i then j, or ``(-1, -1)``.
+
+    Two disks overlap when their centres are closer than the sum of their radii by more than a
+    relative 1e-12 (round-off). Radius-0 particles never overlap anything.
+    """
+    n = position.shape[0]
+    cell_of = np.empty(n, dtype=np.int64)
+    head = np.empty(ncx * ncy, dtype=np.int64)
+    next_ = np.empty(n, dtype=np.int64)
+    prev = np.empty(n, dtype=np.int64)
+    fill_cells(position, radius, 0.5 * width, 0.5 * height, ncx, ncy, cell_of, head, next_, prev)
+    cells, shifts = neighbour_table(ncx, ncy, periodic)
+    best_i = -1
+    best_j = -1
+    for i in range(n):
+        ci = cell_of[i]
+        if ci < 0:
+            continue
+        for k in range(9):
+            c = cells[ci, k]
+            if c < 0:
+                continue
+            j = head[c]
+            while j >= 0:
+                if j > i:
+                    dx = position[j, 0] + shifts[ci, k, 0] * width - position[i, 0]
+                    dy = position[j, 1] + shifts[ci, k, 1] * height - position[i, 1]
+                    sigma = radius[i] + radius[j]
+                    if dx * dx + dy * dy < sigma * sigma * (1.0 - 1e-12) and (
+                        best_j < 0 or j < best_j
+                    ):
+                        best_i = i
+                        best_j = j
+                j = next_[j]
+        if best_i >= 0:
+            return best_i, best_j
+    return best_i, best_j
+
+
+def grid_shape(width: float, height: float, max_diameter: float, n: int) -> tuple[int, int]:
+    """Cells along x and y: at least one diameter wide, at most about 2 cells per particle."""
+    if max_diameter <= 0.0:
+        return 1, 1
+    ncx = max(1, int(width // max_diameter))
+    ncy = max(1, int(height // max_diameter))
+    budget = max(16, 2 * n)
+    while ncx * ncy > budget:
+        ncx = max(1, ncx // 2)
+        ncy = max(1, ncy // 2)
+    return ncx, ncy

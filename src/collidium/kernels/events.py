@@ -1,0 +1,430 @@
+"""Event-driven drift of hard disks: exact free flight between exact elastic collisions.
+
+Design (Rapaport; Donev, Torquato & Stillinger):
+
+- Each particle keeps one next event: a pair contact, a wall contact or a crossing into the next
+  cell of the grid. An indexed binary heap orders particles by that event time, ties by index.
+- Positions are lazy: ``position[i]`` is where particle i was at its own time stamp
+  ``stamp[i]``; at time t it is at ``position[i] + velocity[i] * (t - stamp[i])``.
+- A pair event records the partner's collision count when it was predicted; if the partner has
+  collided since, the event is stale and the particle is simply re-predicted.
+- Cells are at least one largest diameter wide, so a particle's possible partners are in the
+  9 cells around it; crossing into another cell re-predicts it against its new neighbours.
+
+All state lives in arrays owned by the caller (`collidium.collisions.ExactCollisions`), so the queue
+survives from one call to the next: with no forces, dt is only a reporting interval.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from collidium.kernels.cells import fill_cells
+from collidium.kernels.collision import elastic_response
+
+NO_EVENT = 0
+PAIR = 1
+WALL = 2
+CELL = 3
+
+#: Index of each entry of the ``tally`` array.
+PAIR_COLLISIONS = 0
+WALL_HITS = 1  # 4 entries: left, right, bottom, top wall
+
+
+@numba.njit(cache=True, inline="always")
+def contact_delay(dx: float, dy: float, dvx: float, dvy: float, sigma: float) -> float:
+    """Time until two disks touch, or inf.
+
+    Parameters
+    ----------
+    dx, dy : float
+        Separation ``x_j - x_i`` now, in m.
+    dvx, dvy : float
+        Relative velocity ``v_j - v_i`` in m/s.
+    sigma : float
+        Contact distance ``r_i + r_j`` in m.
+
+    Returns
+    -------
+    float
+        Delay in s (0 for an approaching pair already in contact by round-off), inf if the pair is
+        not approaching or misses.
+    """
+    b = dx * dvx + dy * dvy
+    if b >= 0.0:
+        return math.inf
+    gap = dx * dx + dy * dy - sigma * sigma
+    if gap <= 0.0:
+        return 0.0
+    dv2 = dvx * dvx + dvy * dvy
+    disc = b * b - dv2 * gap
+    if disc <= 0.0:
+        return math.inf
+    # Stable root of dv2 t^2 + 2 b t + gap = 0 (no cancellation for grazing contacts).
+    return gap / (-b + math.sqrt(disc))
+
+
+@numba.njit(cache=True, inline="always")
+def _heap_less(a: int, b: int, key: np.ndarray) -> bool:
+    return key[a] < key[b] or (key[a] == key[b] and a < b)
+
+
+@numba.njit(cache=True)
+def _sift_up(slot: int, heap: np.ndarray, where: np.ndarray, key: np.ndarray) -> int:
+    item = heap[slot]
+    while slot > 0:
+        parent = (slot - 1) >> 1
+        if not _heap_less(item, heap[parent], key):
+            break
+        heap[slot] = heap[parent]
+        where[heap[slot]] = slot
+        slot = parent
+    heap[slot] = item
+    where[item] = slot
+    return slot
+
+
+@numba.njit(cache=True)
+def _sift_down(slot: int, heap: np.ndarray, where: np.ndarray, key: np.ndarray) -> None:
+    n = heap.shape[0]
+    item = heap[slot]
+    while True:
+        child = 2 * slot + 1
+        if child >= n:
+            break
+        if child + 1 < n and _heap_less(heap[child + 1], heap[child], key):
+            child += 1
+        if not _heap_less(heap[child], item, key):
+            break
+        heap[slot] = heap[child]
+        where[heap[slot]] = slot
+        slot = child
+    heap[slot] = item
+    where[item] = slot
+
+
+@numba.njit(cache=True)
+def heap_update(i: int, heap: np.ndarray, where: np.ndarray, key: np.ndarray) -> None:
+    """Restore heap order after ``key[i]`` changed (O(log N))."""
+    slot = where[i]
+    if _sift_up(slot, heap, where, key) == slot:
+        _sift_down(slot, heap, where, key)
+
+
+@numba.njit(cache=True)
+def heap_build(heap: np.ndarray, where: np.ndarray, key: np.ndarray) -> None:
+    """Heap of all particles ordered by ``key`` (O(N))."""
+    n = heap.shape[0]
+    for i in range(n):
+        heap[i] = i
+        where[i] = i
+    for slot in range(n // 2 - 1, -1, -1):
+        _sift_down(slot, heap, where, key)
+
+
+@numba.njit(cache=True)
+def predict(
+    i: int,
+    now: float,
+    position: np.ndarray,
+    velocity: np.ndarray,
+    stamp: np.ndarray,
+    radius: np.ndarray,
+    geometry: np.ndarray,
+    grid: np.ndarray,
+    cell_of: np.ndarray,
+    head: np.ndarray,
+    next_: np.ndarray,
+    cells: np.ndarray,
+    shifts: np.ndarray,
+    collisions: np.ndarray,
+    event_time: np.ndarray,
+    event_kind: np.ndarray,
+    event_other: np.ndarray,
+    event_stamp: np.ndarray,
+) -> None:
+    """Find particle i's next event after time ``now`` and store it (not in the heap yet).
+
+    ``geometry`` is ``[half_width, half_height, cell_width, cell_height]`` in m; ``grid`` is
+    ``[ncx, ncy, periodic]``. Ties go to the first found in a fixed order (walls, cells, then the
+    partner with the lowest index), so the outcome does not depend on the order of cell lists.
+    """
+    hw = geometry[0]
+    hh = geometry[1]
+    ncx = grid[0]
+    ncy = grid[1]
+    periodic = grid[2] != 0
+    lag = now - stamp[i]
+    xi = position[i, 0] + velocity[i, 0] * lag
+    yi = position[i, 1] + velocity[i, 1] * lag
+    vxi = velocity[i, 0]
+    vyi = velocity[i, 1]
+    ri = radius[i]
+    best = math.inf
+    kind = NO_EVENT
+    other = -1
+
+    if not periodic:
+        for d in range(2):
+            v = velocity[i, d]
+            x = xi if d == 0 else yi
+            half = hw if d == 0 else hh
+            if v > 0.0:
+                delay = max((half - ri - x) / v, 0.0)
+                if delay < best:
+                    best, kind, other = delay, WALL, 2 * d + 1
+            elif v < 0.0:
+                delay = max((-half + ri - x) / v, 0.0)
+                if delay < best:
+                    best, kind, other = delay, WALL, 2 * d
+
+    c = cell_of[i]
+    if c >= 0:
+        cxy = (c % ncx, c // ncx)
+        counts = (ncx, ncy)
+        for d in range(2):
+            v = velocity[i, d]
+            x = xi if d == 0 else yi
+            half = hw if d == 0 else hh
+            size = geometry[2 + d]
+            k = cxy[d]
+            if v > 0.0 and (periodic or k < counts[d] - 1):
+                delay = max((-half + (k + 1) * size - x) / v, 0.0)
+                if delay < best:
+                    best, kind, other = delay, CELL, 2 * d + 1
+            elif v < 0.0 and (periodic or k > 0):
+                delay = max((-half + k * size - x) / v, 0.0)
+                if delay < best:
+                    best, kind, other = delay, CELL, 2 * d
+
+        if ri > 0.0:
+            width = 2.0 * hw
+            height = 2.0 * hh
+            for q in range(9):
+                cell = cells[c, q]
+                if cell < 0:
+                    continue
+                ox = shifts[c, q, 0] * width
+                oy = shifts[c, q, 1] * height
+                j = head[cell]
+                while j >= 0:
+                    if j != i and radius[j] > 0.0:
+                        lag_j = now - stamp[j]
+                        dx = position[j, 0] + velocity[j, 0] * lag_j + ox - xi
+                        dy = position[j, 1] + velocity[j, 1] * lag_j + oy - yi
+                        delay = contact_delay(
+                            dx, dy, velocity[j, 0] - vxi, velocity[j, 1] - vyi, ri + radius[j]
+                        )
+                        if delay < best or (delay == best and kind == PAIR and j < other):
+                            best, kind, other = delay, PAIR, j
+                    j = next_[j]
+
+    event_time[i] = now + best
+    event_kind[i] = kind
+    event_other[i] = other
+    event_stamp[i] = collisions[other] if kind == PAIR else 0
+
+
+@numba.njit(cache=True, inline="always")
+def _advance(i: int, t: float, position: np.ndarray, velocity: np.ndarray, stamp: np.ndarray):
+    lag = t - stamp[i]
+    position[i, 0] += velocity[i, 0] * lag
+    position[i, 1] += velocity[i, 1] * lag
+    stamp[i] = t
+
+
+@numba.njit(cache=True)
+def _move_to_cell(i: int, new: int, cell_of, head, next_, prev) -> None:
+    old = cell_of[i]
+    if prev[i] >= 0:
+        next_[prev[i]] = next_[i]
+    else:
+        head[old] = next_[i]
+    if next_[i] >= 0:
+        prev[next_[i]] = prev[i]
+    first = head[new]
+    next_[i] = first
+    prev[i] = -1
+    if first >= 0:
+        prev[first] = i
+    head[new] = i
+    cell_of[i] = new
+
+
+@numba.njit(cache=True)
+def _cross_cell(i, direction, position, image, geometry, grid, cell_of, head, next_, prev):
+    """Move particle i into the neighbouring cell; wrap it at a periodic edge."""
+    ncx = grid[0]
+    ncy = grid[1]
+    d = direction // 2
+    step = 1 if direction % 2 == 1 else -1
+    c = cell_of[i]
+    k = (c % ncx, c // ncx)[d]
+    count = (ncx, ncy)[d]
+    k += step
+    if k == count or k < 0:  # periodic edge
+        k %= count
+        span = 2.0 * geometry[d]
+        position[i, d] -= step * span
+        image[i, d] += step
+    cx = k if d == 0 else c % ncx
+    cy = k if d == 1 else c // ncx
+    _move_to_cell(i, cx + ncx * cy, cell_of, head, next_, prev)
+
+
+@numba.njit(cache=True)
+def rebuild(
+    now: float,
+    position: np.ndarray,
+    velocity: np.ndarray,
+    stamp: np.ndarray,
+    radius: np.ndarray,
+    geometry: np.ndarray,
+    grid: np.ndarray,
+    cell_of: np.ndarray,
+    head: np.ndarray,
+    next_: np.ndarray,
+    prev: np.ndarray,
+    cells: np.ndarray,
+    shifts: np.ndarray,
+    collisions: np.ndarray,
+    event_time: np.ndarray,
+    event_kind: np.ndarray,
+    event_other: np.ndarray,
+    event_stamp: np.ndarray,
+    heap: np.ndarray,
+    heap_where: np.ndarray,
+) -> None:
+    """Start a fresh queue at time ``now`` from synchronised positions (all stamps = now)."""
+    stamp[:] = now
+    fill_cells(
+        position, radius, geometry[0], geometry[1], grid[0], grid[1], cell_of, head, next_, prev
+    )
+    for i in range(position.shape[0]):
+        predict(
+            i, now, position, velocity, stamp, radius, geometry, grid, cell_of, head, next_,
+            cells, shifts, collisions, event_time, event_kind, event_other, event_stamp,
+        )  # fmt: skip
+    heap_build(heap, heap_where, event_time)
+
+
+@numba.njit(cache=True)
+def run_events(
+    until: float,
+    position: np.ndarray,
+    velocity: np.ndarray,
+    stamp: np.ndarray,
+    mass: np.ndarray,
+    radius: np.ndarray,
+    image: np.ndarray,
+    geometry: np.ndarray,
+    grid: np.ndarray,
+    cell_of: np.ndarray,
+    head: np.ndarray,
+    next_: np.ndarray,
+    prev: np.ndarray,
+    cells: np.ndarray,
+    shifts: np.ndarray,
+    collisions: np.ndarray,
+    event_time: np.ndarray,
+    event_kind: np.ndarray,
+    event_other: np.ndarray,
+    event_stamp: np.ndarray,
+    heap: np.ndarray,
+    heap_where: np.ndarray,
+    tally: np.ndarray,
+) -> int:
+    """Process every event up to time ``until`` (inclusive) in time order.
+
+    Parameters
+    ----------
+    until : float
+        End of the drift, in s (absolute simulation time).
+    tally : ndarray of int64, shape (5,)
+        Incremented: pair collisions, then hits on the left, right, bottom, top wall.
+    (other arrays)
+        Engine state as built by `rebuild`; updated in place.
+
+    Returns
+    -------
+    int
+        Number of events processed (including cell crossings and stale events).
+    """
+    processed = 0
+    n = position.shape[0]
+    if n == 0:
+        return 0
+    while True:
+        i = heap[0]
+        t = event_time[i]
+        if t > until:
+            break
+        processed += 1
+        kind = event_kind[i]
+        if kind == PAIR:
+            j = event_other[i]
+            if collisions[j] == event_stamp[i]:
+                _advance(i, t, position, velocity, stamp)
+                _advance(j, t, position, velocity, stamp)
+                # Contact normal x_i - x_j; in contact the pair is at most half a side apart,
+                # so the minimum image is the one that touches.
+                nx = position[i, 0] - position[j, 0]
+                ny = position[i, 1] - position[j, 1]
+                if grid[2] != 0:
+                    nx -= 2.0 * geometry[0] * round(nx / (2.0 * geometry[0]))
+                    ny -= 2.0 * geometry[1] * round(ny / (2.0 * geometry[1]))
+                v1x, v1y, v2x, v2y = elastic_response(
+                    mass[i], mass[j], nx, ny,
+                    velocity[i, 0], velocity[i, 1], velocity[j, 0], velocity[j, 1],
+                )  # fmt: skip
+                velocity[i, 0] = v1x
+                velocity[i, 1] = v1y
+                velocity[j, 0] = v2x
+                velocity[j, 1] = v2y
+                collisions[i] += 1
+                collisions[j] += 1
+                tally[PAIR_COLLISIONS] += 1
+                predict(
+                    j, t, position, velocity, stamp, radius, geometry, grid, cell_of, head,
+                    next_, cells, shifts, collisions, event_time, event_kind, event_other,
+                    event_stamp,
+                )  # fmt: skip
+                heap_update(j, heap, heap_where, event_time)
+        elif kind == WALL:
+            _advance(i, t, position, velocity, stamp)
+            wall = event_other[i]
+            d = wall // 2
+            half = geometry[d]
+            # Snap to the contact point so round-off never leaves the disk past the wall.
+            position[i, d] = (half - radius[i]) if wall % 2 == 1 else (radius[i] - half)
+            velocity[i, d] = -velocity[i, d]
+            collisions[i] += 1
+            tally[WALL_HITS + wall] += 1
+        elif kind == CELL:
+            _advance(i, t, position, velocity, stamp)
+            _cross_cell(
+                i, event_other[i], position, image, geometry, grid, cell_of, head, next_, prev
+            )
+        predict(
+            i, t, position, velocity, stamp, radius, geometry, grid, cell_of, head, next_,
+            cells, shifts, collisions, event_time, event_kind, event_other, event_stamp,
+        )  # fmt: skip
+        heap_update(i, heap, heap_where, event_time)
+    return processed
+
+
+@numba.njit(cache=True)
+def synchronise(
+    now: float, position: np.ndarray, velocity: np.ndarray, stamp: np.ndarray, out: np.ndarray
+) -> None:
+    """Write every particle's position at time ``now`` into ``out`` (shape (N, 2)), lazily kept
+    state untouched so the queue stays valid."""
+    for i in range(position.shape[0]):
+        lag = now - stamp[i]
+        out[i, 0] = position[i, 0] + velocity[i, 0] * lag
+        out[i, 1] = position[i, 1] + velocity[i, 1] * lag
+

@@ -1,0 +1,167 @@
+"""Plain NumPy twins of the compiled kernels, written for clarity, not speed; tests compare them.
+
+Each function here computes what its kernel computes, by the most direct method (all pairs, one
+event at a time), so an optimisation in a kernel can always be checked against it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from collidium.state import FloatArray
+
+
+def elastic_response(
+    m1: float, m2: float, x1: FloatArray, x2: FloatArray, v1: FloatArray, v2: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Seed eq. 7 as written: velocities (2,) after an elastic collision of disks at x1, x2."""
+    n = x1 - x2
+    v1_new = v1 - 2 * m2 / (m1 + m2) * np.dot(v1 - v2, n) / np.dot(n, n) * n
+    v2_new = v2 - 2 * m1 / (m1 + m2) * np.dot(v2 - v1, -n) / np.dot(n, n) * (-n)
+    return v1_new, v2_new
+
+
+def fold(x: float, v: float, lo: float, hi: float) -> tuple[float, float, int]:
+    """Reflect a coordinate back into ``[lo, hi]`` one bounce at a time (twin of `walls.fold`)."""
+    bounces = 0
+    while x < lo or x > hi:
+        x = 2 * lo - x if x < lo else 2 * hi - x
+        v = -v
+        bounces += 1
+    return x, v, bounces
+
+
+def coulomb_direct(
+    position: FloatArray,
+    charge: FloatArray,
+    k: float,
+    softening2: float,
+    size: FloatArray | None = None,
+) -> tuple[FloatArray, FloatArray]:
+    """Coulomb forces (N, 2) and per-particle half pair energies (N,) over all pairs at once.
+
+    ``size`` (the box sides) turns on the minimum image.
+    """
+    d = position[:, None, :] - position[None, :, :]
+    if size is not None:
+        d -= size * np.round(d / size)
+    r2 = np.einsum("ijk,ijk->ij", d, d) + softening2
+    np.fill_diagonal(r2, np.inf)
+    qq = charge[:, None] * charge[None, :]
+    inv = 1.0 / np.sqrt(r2)
+    force = np.einsum("ij,ijk->ik", k * qq * inv**3, d)
+    return force, 0.5 * np.sum(k * qq * inv, axis=1)
+
+
+def first_overlap(position: FloatArray, radius: FloatArray) -> tuple[int, int]:
+    """The overlapping pair with the smallest (i, j), or (-1, -1); all pairs, reflecting box."""
+    d = np.linalg.norm(position[:, None] - position[None, :], axis=2)
+    sigma = radius[:, None] + radius[None, :]
+    bad = (d < sigma * (1 - 1e-12)) & np.triu(np.ones_like(d, dtype=bool), 1)
+    bad &= (radius[:, None] > 0) & (radius[None, :] > 0)
+    pairs = np.argwhere(bad)
+    return (int(pairs[0, 0]), int(pairs[0, 1])) if len(pairs) else (-1, -1)
+
+
+def step_collisions(
+    position: FloatArray, velocity: FloatArray, mass: FloatArray, radius: FloatArray
+) -> int:
+    """Seed method, resolution part: every overlapping pair (i < j, index order) that is approaching
+    gets the elastic response. Velocities updated in place; returns the count (reflecting box).
+    Radius-0 particles take no part."""
+    done = 0
+    n = len(position)
+    for i in range(n):
+        for j in range(i + 1, n):
+            if radius[i] == 0 or radius[j] == 0:
+                continue
+            sep = position[i] - position[j]
+            if np.dot(sep, sep) >= (radius[i] + radius[j]) ** 2:
+                continue
+            if np.dot(sep, velocity[i] - velocity[j]) >= 0:
+                continue
+            velocity[i], velocity[j] = elastic_response(
+                mass[i], mass[j], position[i], position[j], velocity[i], velocity[j]
+            )
+            done += 1
+    return done
+
+
+def event_drift(
+    position: FloatArray,
+    velocity: FloatArray,
+    mass: FloatArray,
+    radius: FloatArray,
+    half: FloatArray,
+    duration: float,
+    periodic: bool = False,
+) -> tuple[int, int]:
+    """Event-driven hard disks, all pairs (and, if periodic, all 9 images) checked at every event.
+
+    Positions and velocities (N, 2) are updated in place (periodic positions are left unwrapped);
+    returns (pair collisions, wall hits).
+    """
+    now = 0.0
+    pairs = walls = 0
+    while True:
+        t_pair, i, j = _next_contact(position, velocity, radius, 2 * half, periodic)
+        t_wall, k, d = (math.inf, -1, -1) if periodic else _next_wall(position, velocity, radius, half)
+        best = min(t_pair, t_wall)
+        if now + best > duration:
+            position += velocity * (duration - now)
+            return pairs, walls
+        position += velocity * best
+        now += best
+        if t_wall < t_pair:
+            velocity[k, d] = -velocity[k, d]
+            walls += 1
+        else:
+            sep = position[i] - position[j]
+            if periodic:
+                sep -= 2 * half * np.round(sep / (2 * half))
+            velocity[i], velocity[j] = elastic_response(
+                mass[i], mass[j], sep, np.zeros(2), velocity[i], velocity[j]
+            )
+            pairs += 1
+
+
+def _next_wall(
+    position: FloatArray, velocity: FloatArray, radius: FloatArray, half: FloatArray
+) -> tuple[float, int, int]:
+    """Earliest wall contact: (delay, particle, axis)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        target = np.where(velocity > 0, half - radius[:, None], radius[:, None] - half)
+        delay = np.where(velocity != 0, (target - position) / velocity, np.inf)
+    delay = np.maximum(delay, 0.0)
+    k, d = np.unravel_index(np.argmin(delay), delay.shape)
+    return float(delay[k, d]), int(k), int(d)
+
+
+def _next_contact(
+    position: FloatArray, velocity: FloatArray, radius: FloatArray, size: FloatArray, periodic: bool
+) -> tuple[float, int, int]:
+    """Earliest pair contact over all pairs i < j (and the 9 nearest images): (delay, i, j)."""
+    n = len(position)
+    base = position[None, :, :] - position[:, None, :]  # x_j - x_i
+    shifts = [np.zeros(2)]
+    if periodic:
+        base -= size * np.round(base / size)
+        shifts = [size * np.array([a, b]) for a in (-1, 0, 1) for b in (-1, 0, 1)]
+    dv = velocity[None, :, :] - velocity[:, None, :]
+    a = np.einsum("ijk,ijk->ij", dv, dv)
+    sigma2 = (radius[:, None] + radius[None, :]) ** 2
+    takes_part = np.triu(np.ones((n, n), dtype=bool), 1) & (radius[:, None] > 0) & (radius > 0)
+    best, pair = math.inf, (-1, -1)
+    for shift in shifts:
+        dx = base + shift
+        b = np.einsum("ijk,ijk->ij", dx, dv)
+        disc = b * b - a * (np.einsum("ijk,ijk->ij", dx, dx) - sigma2)
+        hits = takes_part & (b < 0) & (disc > 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            delay = np.where(hits, np.maximum((-b - np.sqrt(disc)) / a, 0.0), np.inf)
+        if n > 1 and delay.min() < best:
+            i, j = np.unravel_index(np.argmin(delay), delay.shape)
+            best, pair = float(delay[i, j]), (int(i), int(j))
+    return best, pair[0], pair[1]

@@ -1,0 +1,306 @@
+"""`Simulation`: owns the state, the vessel, the forces, the integrator and the observers.
+
+Run loop, one step of length dt:
+
+1. kick: ``v += a dt/2`` (only with forces);
+2. drift: the collision mode moves the particles for dt (exact events, the seed's step method, or
+   pass-through), reflecting from walls or wrapping in a periodic box;
+3. forces at the new positions, kick: ``v += a dt/2``;
+4. ``time += dt``, ``steps += 1``;
+5. audit: a NaN/infinity or a particle outside the vessel stops the run with `SimulationError`;
+6. observers whose trigger fires on ``steps`` are updated.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from collidium.collisions import COLLISION_MODES, CollisionMode, make_drift
+from collidium.containers import OUTSIDE_TOLERANCE, Box
+from collidium.errors import InputError, SimulationError
+from collidium.forces import Coulomb, ForceField
+from collidium.integrators import Leapfrog
+from collidium.kernels.audit import first_invalid
+from collidium.kernels.cells import first_overlap, grid_shape
+from collidium.observers.base import Observer
+from collidium.state import FloatArray, Particles
+
+WALL_NAMES = ("left", "right", "bottom", "top")
+
+
+@dataclass(frozen=True)
+class Energy:
+    """Energies in J."""
+
+    kinetic: float
+    potential: float
+
+    @property
+    def total(self) -> float:
+        """Kinetic plus potential energy in J."""
+        return self.kinetic + self.potential
+
+
+@dataclass(frozen=True)
+class Counters:
+    """Collision counts since the simulation was created."""
+
+    pair_collisions: int
+    wall_hits: dict[str, int]
+
+    @property
+    def wall_collisions(self) -> int:
+        """Hits on all walls together."""
+        return sum(self.wall_hits.values())
+
+
+class Simulation:
+    """Particles in a vessel, advanced by leapfrog with exact (or seed-style) collisions.
+
+    Parameters
+    ----------
+    container : Box
+        The vessel.
+    particles : Particles
+        Initial state (the simulation keeps and updates this object).
+    forces : sequence of Coulomb, optional
+        Forces between particles; none for a free (hard-disk) gas.
+    dt : float
+        Time step in s (> 0). Without forces and with exact collisions it is only the interval
+        between reports: the motion is exact whatever its value.
+    collisions : {"exact", "step", "off"}
+        Collision handling, see `collidium.collisions`.
+    seed : int, optional
+        Seed of the simulation's random generator (`rng`).
+    name : str, optional
+        Label used in summaries (the scenario or preset name).
+
+    Raises
+    ------
+    InputError
+        For a bad dt or mode, disks too large for the box, overlapping disks (the pair is named) or
+        a particle outside the vessel.
+    """
+
+    def __init__(
+        self,
+        container: Box,
+        particles: Particles,
+        forces: Sequence[Coulomb] = (),
+        dt: float = 0.01,
+        collisions: CollisionMode = "exact",
+        seed: int | None = None,
+        name: str | None = None,
+    ) -> None:
+        _check_setup(container, particles, forces, dt, collisions)
+        self.container = container
+        self.particles = particles
+        self.dt = float(dt)
+        self.collisions: CollisionMode = collisions
+        self.seed = seed
+        self.rng = np.random.default_rng(seed)
+        self.name = name or "custom"
+        self.time = 0.0
+        self.steps = 0
+        self.observers: list[Observer] = []
+        self._attached: set[int] = set()
+        self._field = ForceField(tuple(forces))
+        self._drift = make_drift(collisions)
+        self._integrator = Leapfrog()
+        self._tally = np.zeros(5, dtype=np.int64)
+        if container.periodic:
+            wrapped = container.wrap(particles.position)
+            size = container.size
+            particles.image += np.rint((particles.position - wrapped) / size).astype(np.int64)
+            particles.position[...] = wrapped
+        _check_placement(container, particles, collisions)
+
+    @property
+    def forces(self) -> tuple[Coulomb, ...]:
+        """The forces acting."""
+        return self._field.forces
+
+    def run(
+        self, time: float | None = None, steps: int | None = None, progress: bool = False
+    ) -> Simulation:
+        """Advance by a duration or a number of steps.
+
+        Parameters
+        ----------
+        time : float, optional
+            Duration in s, rounded to a whole number of steps of ``dt``.
+        steps : int, optional
+            Number of steps (give one of ``time`` and ``steps``).
+        progress : bool
+            Show a rich progress bar on stderr.
+
+        Returns
+        -------
+        Simulation
+            ``self``, to chain calls.
+        """
+        count = _step_count(time, steps, self.dt)
+        for observer in self.observers:
+            if id(observer) not in self._attached:
+                observer.attach(self)
+                self._attached.add(id(observer))
+        if self._field.active:
+            self._field.evaluate(self.particles, self.container)
+        if progress:
+            from rich.progress import Progress
+
+            with Progress(transient=True) as bar:
+                task = bar.add_task(f"{self.name}", total=count)
+                stride = max(1, count // 200)
+                for k in range(count):
+                    self._step()
+                    if (k + 1) % stride == 0 or k + 1 == count:
+                        bar.update(task, completed=k + 1)
+        else:
+            for _ in range(count):
+                self._step()
+        return self
+
+    def _step(self) -> None:
+        self._integrator.step(
+            self.particles, self.container, self._field, self._drift, self.time, self.dt,
+            self._tally,
+        )  # fmt: skip
+        self.time += self.dt
+        self.steps += 1
+        self._audit()
+        for observer in self.observers:
+            if observer.trigger(self.steps):
+                observer.update(self)
+
+    def _audit(self) -> None:
+        p = self.particles
+        box = self.container
+        index, reason = first_invalid(
+            p.position, p.velocity, p.radius, 0.5 * box.width, 0.5 * box.height, box.periodic,
+            OUTSIDE_TOLERANCE,
+        )  # fmt: skip
+        if index < 0:
+            return
+        what = "a non-finite position or velocity" if reason == 1 else "left the vessel"
+        bad = np.flatnonzero(~np.isfinite(p.position).all(1) | ~np.isfinite(p.velocity).all(1))
+        if reason == 2:
+            bad = box.outside(p.position, p.radius)
+        listed = ", ".join(str(int(i)) for i in bad[:10]) + (" ..." if bad.size > 10 else "")
+        raise SimulationError(
+            f"step {self.steps} (t = {self.time:.6g} s): particle(s) {listed} {what}"
+            + ("; try a smaller dt or softening" if reason == 1 else "")
+        )
+
+    def energy(self) -> Energy:
+        """Kinetic (``sum m v^2 / 2``) and potential (pair sum, seed eq. 10) energy in J."""
+        p = self.particles
+        kinetic = 0.5 * float(np.sum(p.mass * np.einsum("ij,ij->i", p.velocity, p.velocity)))
+        return Energy(kinetic, self._field.potential(p, self.container))
+
+    def momentum(self) -> FloatArray:
+        """Total momentum ``sum m v``, shape (2,), in kg m/s."""
+        return np.asarray(self.particles.mass @ self.particles.velocity)
+
+    def total_speed(self) -> float:
+        """Sum of the particles' speeds in m/s (the seed's "total speed", Fig. 2)."""
+        return float(np.sum(np.hypot(self.particles.velocity[:, 0], self.particles.velocity[:, 1])))
+
+    @property
+    def counters(self) -> Counters:
+        """Pair collisions and wall hits (per wall) since the start."""
+        hits = {name: int(self._tally[1 + k]) for k, name in enumerate(WALL_NAMES)}
+        return Counters(int(self._tally[0]), hits)
+
+    def escaped(self) -> int:
+        """Number of particles outside the vessel (always 0 unless something is badly wrong)."""
+        return int(self.container.outside(self.particles.position, self.particles.radius).size)
+
+    def unwrapped_position(self) -> FloatArray:
+        """Positions (N, 2) in m with periodic wrapping undone (equal to position otherwise)."""
+        return self.particles.position + self.particles.image * self.container.size
+
+    def summary(self) -> dict[str, Any]:
+        """Plain numbers describing the current state (used by the CLI)."""
+        e = self.energy()
+        c = self.counters
+        return {
+            "scenario": self.name,
+            "n": self.particles.n,
+            "time": self.time,
+            "steps": self.steps,
+            "energy": {"kinetic": e.kinetic, "potential": e.potential, "total": e.total},
+            "momentum": [float(x) for x in self.momentum()],
+            "total_speed": self.total_speed(),
+            "collisions": {"pair": c.pair_collisions, "wall": c.wall_collisions},
+            "escaped": self.escaped(),
+        }
+
+    def __repr__(self) -> str:
+        return (
+            f"Simulation({self.name!r}, n={self.particles.n}, {self.container!r}, "
+            f"collisions={self.collisions!r}, dt={self.dt}, time={self.time:.6g})"
+        )
+
+
+def _step_count(time: float | None, steps: int | None, dt: float) -> int:
+    if (time is None) == (steps is None):
+        raise InputError("time", "give exactly one of time and steps")
+    if steps is not None:
+        if isinstance(steps, bool) or int(steps) != steps or steps < 0:
+            raise InputError("steps", f"must be a whole number >= 0, got {steps!r}")
+        return int(steps)
+    assert time is not None
+    if not math.isfinite(time) or time < 0:
+        raise InputError("time", f"must be a finite number >= 0, got {time!r}")
+    return round(time / dt)
+
+
+def _check_setup(
+    container: Box,
+    particles: Particles,
+    forces: Sequence[Coulomb],
+    dt: float,
+    collisions: str,
+) -> None:
+    if not isinstance(container, Box):
+        raise InputError("container", f"must be a Box, got {type(container).__name__}")
+    if not isinstance(particles, Particles):
+        raise InputError("particles", f"must be Particles, got {type(particles).__name__}")
+    for k, force in enumerate(forces):
+        if not isinstance(force, Coulomb):
+            raise InputError(f"forces.{k}", f"unknown force {type(force).__name__}")
+    if isinstance(dt, bool) or not isinstance(dt, int | float) or not math.isfinite(dt) or dt <= 0:
+        raise InputError("dt", f"must be a finite number > 0, got {dt!r}")
+    if collisions not in COLLISION_MODES:
+        raise InputError("collisions", f"must be one of {COLLISION_MODES}, got {collisions!r}")
+    container.check_fits(particles.radius)
+
+
+def _check_placement(container: Box, particles: Particles, collisions: str) -> None:
+    outside = container.outside(particles.position, particles.radius)
+    if outside.size:
+        i = int(outside[0])
+        x, y = particles.position[i]
+        raise InputError(
+            "position",
+            f"particle {i} at ({x:g}, {y:g}) with radius {particles.radius[i]:g} is outside "
+            f"the {container.width:g} x {container.height:g} box",
+        )
+    if collisions == "off":
+        return  # pass-through disks may overlap
+    ncx, ncy = grid_shape(
+        container.width, container.height, 2.0 * float(particles.radius.max(initial=0.0)),
+        particles.n,
+    )  # fmt: skip
+    i, j = first_overlap(
+        particles.position, particles.radius, container.width, container.height,
+        container.periodic, ncx, ncy,
+    )  # fmt: skip
+    if i >= 0:
+        raise InputError("position", f"particles {i} and {j} overlap")

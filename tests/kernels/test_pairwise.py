@@ -1,0 +1,68 @@
+"""Coulomb direct sum: gradient of the potential, Newton's third law, NumPy twin."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from collidium.kernels import reference
+from collidium.kernels.pairwise import coulomb_direct
+
+
+def _coulomb(position, charge, k=5.0, eps2=0.0, size=None):
+    n = len(position)
+    force = np.empty((n, 2))
+    energy = np.empty(n)
+    periodic = size is not None
+    w, h = (size if periodic else (0.0, 0.0))
+    coulomb_direct(position, charge, k, eps2, w, h, periodic, force, energy)
+    return force, energy
+
+
+@pytest.fixture
+def charges(rng):
+    n = 40
+    position = rng.uniform(-8, 8, (n, 2))
+    charge = rng.choice([-1.0, 1.0, 0.5, 0.0], n)
+    return position, charge
+
+
+@pytest.mark.parametrize("eps2", [0.0, 0.05**2])
+def test_forces_are_minus_the_gradient_of_the_potential(charges, eps2):
+    position, charge = charges
+    force, _ = _coulomb(position, charge, eps2=eps2)
+    h = 1e-6
+    for i in (0, 7, 21):
+        for d in range(2):
+            plus, minus = position.copy(), position.copy()
+            plus[i, d] += h
+            minus[i, d] -= h
+            u_plus = _coulomb(plus, charge, eps2=eps2)[1].sum()
+            u_minus = _coulomb(minus, charge, eps2=eps2)[1].sum()
+            gradient = (u_plus - u_minus) / (2 * h)
+            # Central difference: O(h^2) truncation plus round-off of U / h.
+            tolerance = 1e-6 * max(1.0, abs(force[i, d]))
+            assert abs(force[i, d] + gradient) < tolerance
+
+
+def test_forces_sum_to_zero(charges):
+    position, charge = charges
+    force, _ = _coulomb(position, charge)
+    scale = np.abs(force).sum()
+    np.testing.assert_allclose(force.sum(axis=0), 0.0, atol=1e-14 * scale)
+
+
+def test_potential_of_two_charges_is_k_q1_q2_over_r():
+    force, energy = _coulomb(np.array([[-2.0, 0.0], [2.0, 0.0]]), np.array([1.0, -1.0]))
+    assert energy.sum() == pytest.approx(-5.0 / 4.0, rel=1e-15)
+    assert force[0, 0] == pytest.approx(5.0 / 16.0, rel=1e-15)  # attracted to the right
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_kernel_equals_numpy_twin(charges, periodic):
+    position, charge = charges
+    size = np.array([16.0, 16.0]) if periodic else None
+    got_force, got_energy = _coulomb(position, charge, eps2=0.01, size=size)
+    want_force, want_energy = reference.coulomb_direct(position, charge, 5.0, 0.01, size)
+    np.testing.assert_allclose(got_force, want_force, rtol=1e-12, atol=1e-13)
+    np.testing.assert_allclose(got_energy, want_energy, rtol=1e-12, atol=1e-13)
