@@ -148,13 +148,14 @@ class ExactCollisions:
             "event_other": np.empty(n, dtype=np.int64),
             "event_stamp": np.empty(n, dtype=np.int64),
             "heap": np.empty(n, dtype=np.int64),
+            "heap_keys": np.empty(n),
             "heap_where": np.empty(n, dtype=np.int64),
         }  # fmt: skip
         events.rebuild(
             now, s["position"], s["velocity"], s["stamp"], particles.radius, s["geometry"],
             s["grid"], s["cell_of"], s["head"], s["next"], s["prev"], s["cells"], s["shifts"],
             s["collisions"], s["event_time"], s["event_kind"], s["event_other"],
-            s["event_stamp"], s["heap"], s["heap_where"],
+            s["event_stamp"], s["heap"], s["heap_keys"], s["heap_where"],
         )  # fmt: skip
         return s
 
@@ -169,7 +170,8 @@ class ExactCollisions:
             until, s["position"], s["velocity"], s["stamp"], particles.mass, particles.radius,
             particles.image, s["geometry"], s["grid"], s["cell_of"], s["head"], s["next"],
             s["prev"], s["cells"], s["shifts"], s["collisions"], s["event_time"],
-            s["event_kind"], s["event_other"], s["event_stamp"], s["heap"], s["heap_where"], tally,
+            s["event_kind"], s["event_other"], s["event_stamp"], s["heap"], s["heap_keys"],
+            s["heap_where"], tally,
         )  # fmt: skip
         events.synchronise(until, s["position"], s["velocity"], s["stamp"], particles.position)
         particles.velocity[...] = s["velocity"]

@@ -69,61 +69,73 @@ def contact_delay(dx: float, dy: float, dvx: float, dvy: float, sigma: float) ->
 
 
 @numba.njit(cache=True, inline="always")
-def _heap_less(a: int, b: int, key: np.ndarray) -> bool:
-    return key[a] < key[b] or (key[a] == key[b] and a < b)
+def _before(key_a: float, a: int, key_b: float, b: int) -> bool:
+    return key_a < key_b or (key_a == key_b and a < b)
 
 
 @numba.njit(cache=True)
-def _sift_up(slot: int, heap: np.ndarray, where: np.ndarray, key: np.ndarray) -> int:
+def _sift_up(slot: int, heap: np.ndarray, keys: np.ndarray, where: np.ndarray) -> int:
     item = heap[slot]
+    key = keys[slot]
     while slot > 0:
         parent = (slot - 1) >> 1
-        if not _heap_less(item, heap[parent], key):
+        if not _before(key, item, keys[parent], heap[parent]):
             break
         heap[slot] = heap[parent]
+        keys[slot] = keys[parent]
         where[heap[slot]] = slot
         slot = parent
     heap[slot] = item
+    keys[slot] = key
     where[item] = slot
     return slot
 
 
 @numba.njit(cache=True)
-def _sift_down(slot: int, heap: np.ndarray, where: np.ndarray, key: np.ndarray) -> None:
+def _sift_down(slot: int, heap: np.ndarray, keys: np.ndarray, where: np.ndarray) -> None:
     n = heap.shape[0]
     item = heap[slot]
+    key = keys[slot]
     while True:
         child = 2 * slot + 1
         if child >= n:
             break
-        if child + 1 < n and _heap_less(heap[child + 1], heap[child], key):
+        if child + 1 < n and _before(keys[child + 1], heap[child + 1], keys[child], heap[child]):
             child += 1
-        if not _heap_less(heap[child], item, key):
+        if not _before(keys[child], heap[child], key, item):
             break
         heap[slot] = heap[child]
+        keys[slot] = keys[child]
         where[heap[slot]] = slot
         slot = child
     heap[slot] = item
+    keys[slot] = key
     where[item] = slot
 
 
 @numba.njit(cache=True)
-def heap_update(i: int, heap: np.ndarray, where: np.ndarray, key: np.ndarray) -> None:
-    """Restore heap order after ``key[i]`` changed (O(log N))."""
+def heap_update(i: int, key: float, heap: np.ndarray, keys: np.ndarray, where: np.ndarray) -> None:
+    """Give particle i the event time ``key`` and restore heap order (O(log N)).
+
+    The heap keeps each key next to its particle index (``keys[slot]``) so that sifting reads
+    contiguous memory instead of chasing ``event_time[heap[slot]]``.
+    """
     slot = where[i]
-    if _sift_up(slot, heap, where, key) == slot:
-        _sift_down(slot, heap, where, key)
+    keys[slot] = key
+    if _sift_up(slot, heap, keys, where) == slot:
+        _sift_down(slot, heap, keys, where)
 
 
 @numba.njit(cache=True)
-def heap_build(heap: np.ndarray, where: np.ndarray, key: np.ndarray) -> None:
-    """Heap of all particles ordered by ``key`` (O(N))."""
+def heap_build(event_time: np.ndarray, heap: np.ndarray, keys: np.ndarray, where: np.ndarray):
+    """Heap of all particles ordered by ``event_time`` then index (O(N))."""
     n = heap.shape[0]
     for i in range(n):
         heap[i] = i
+        keys[i] = event_time[i]
         where[i] = i
     for slot in range(n // 2 - 1, -1, -1):
-        _sift_down(slot, heap, where, key)
+        _sift_down(slot, heap, keys, where)
 
 
 @numba.njit(cache=True)
@@ -297,6 +309,7 @@ def rebuild(
     event_other: np.ndarray,
     event_stamp: np.ndarray,
     heap: np.ndarray,
+    heap_keys: np.ndarray,
     heap_where: np.ndarray,
 ) -> None:
     """Start a fresh queue at time ``now`` from synchronised positions (all stamps = now)."""
@@ -309,7 +322,7 @@ def rebuild(
             i, now, position, velocity, stamp, radius, geometry, grid, cell_of, head, next_,
             cells, shifts, collisions, event_time, event_kind, event_other, event_stamp,
         )  # fmt: skip
-    heap_build(heap, heap_where, event_time)
+    heap_build(event_time, heap, heap_keys, heap_where)
 
 
 @numba.njit(cache=True)
@@ -335,6 +348,7 @@ def run_events(
     event_other: np.ndarray,
     event_stamp: np.ndarray,
     heap: np.ndarray,
+    heap_keys: np.ndarray,
     heap_where: np.ndarray,
     tally: np.ndarray,
 ) -> int:
@@ -360,7 +374,7 @@ def run_events(
         return 0
     while True:
         i = heap[0]
-        t = event_time[i]
+        t = heap_keys[0]
         if t > until:
             break
         processed += 1
@@ -393,7 +407,7 @@ def run_events(
                     next_, cells, shifts, collisions, event_time, event_kind, event_other,
                     event_stamp,
                 )  # fmt: skip
-                heap_update(j, heap, heap_where, event_time)
+                heap_update(j, event_time[j], heap, heap_keys, heap_where)
         elif kind == WALL:
             _advance(i, t, position, velocity, stamp)
             wall = event_other[i]
@@ -413,7 +427,7 @@ def run_events(
             i, t, position, velocity, stamp, radius, geometry, grid, cell_of, head, next_,
             cells, shifts, collisions, event_time, event_kind, event_other, event_stamp,
         )  # fmt: skip
-        heap_update(i, heap, heap_where, event_time)
+        heap_update(i, event_time[i], heap, heap_keys, heap_where)
     return processed
 
 

@@ -1,0 +1,83 @@
+"""Particles: shapes, broadcasting and one clear message per kind of bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from collidium import Box, InputError, Particles, Simulation
+
+
+def test_scalars_broadcast_and_velocity_defaults_to_rest():
+    p = Particles(position=[[0.0, 0.0], [1.0, 1.0]], mass=2.0, radius=0.1, charge=[1, -1])
+    assert p.n == 2
+    np.testing.assert_array_equal(p.mass, [2.0, 2.0])
+    np.testing.assert_array_equal(p.velocity, np.zeros((2, 2)))
+    assert p.position.dtype == np.float64 and p.charge.dtype == np.float64
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field", "words"),
+    [
+        ({"position": [[0.0, np.nan]]}, "position", "not finite"),
+        ({"position": [[0.0, 0.0]], "velocity": [[np.inf, 0.0]]}, "velocity", "not finite"),
+        ({"position": [[0.0, 0.0]], "mass": 0.0}, "mass", "> 0"),
+        ({"position": [[0.0, 0.0]], "mass": [-1.0]}, "mass", "> 0"),
+        ({"position": [[0.0, 0.0]], "radius": -0.1}, "radius", ">= 0"),
+        ({"position": [[0.0, 0.0, 0.0]]}, "position", "shape"),
+        ({"position": [[0.0, 0.0]], "velocity": [[1.0, 0.0], [0.0, 0.0]]}, "velocity", "shape"),
+        ({"position": [[0.0, 0.0]], "charge": [1.0, 2.0]}, "charge", "1 values"),
+        ({"position": [["a", 0.0]]}, "position", "not an array"),
+    ],
+)
+def test_bad_particles_name_the_field(kwargs, field, words):
+    with pytest.raises(InputError) as info:
+        Particles(**kwargs)
+    assert info.value.field == field
+    assert words in str(info.value)
+    assert "\n" not in str(info.value)
+
+
+def test_overlapping_pair_is_named():
+    p = Particles(position=[[0.0, 0.0], [3.0, 0.0], [3.3, 0.0]], radius=0.25)
+    with pytest.raises(InputError, match="particles 1 and 2 overlap"):
+        Simulation(Box(20, 20), p)
+
+
+def test_overlap_allowed_when_collisions_are_off():
+    p = Particles(position=[[0.0, 0.0], [0.1, 0.0]], radius=0.25)
+    Simulation(Box(20, 20), p, collisions="off")
+
+
+def test_particle_outside_the_vessel_is_named():
+    p = Particles(position=[[0.0, 0.0], [9.9, 0.0]], radius=0.25)
+    with pytest.raises(InputError, match="particle 1 .* outside"):
+        Simulation(Box(20, 20), p)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [({"dt": 0.0}, "dt"), ({"dt": float("nan")}, "dt"), ({"collisions": "sticky"}, "collisions")],
+)
+def test_bad_simulation_settings_name_the_field(kwargs, field):
+    with pytest.raises(InputError) as info:
+        Simulation(Box(20, 20), Particles(position=[[0.0, 0.0]]), **kwargs)
+    assert info.value.field == field
+
+
+@pytest.mark.parametrize(
+    ("args", "field"),
+    [((0, 10), "box.width"), ((10, -1), "box.height"), ((10, 10, "sticky"), "box.boundary")],
+)
+def test_bad_box_names_the_field(args, field):
+    with pytest.raises(InputError) as info:
+        Box(*args)
+    assert info.value.field == field
+
+
+def test_periodic_positions_are_wrapped_and_images_kept():
+    p = Particles(position=[[12.0, -31.0]], radius=0.25)
+    sim = Simulation(Box(20, 20, "periodic"), p)
+    np.testing.assert_allclose(sim.particles.position, [[-8.0, 9.0]])
+    np.testing.assert_array_equal(sim.particles.image, [[1, -2]])
+    np.testing.assert_allclose(sim.unwrapped_position(), [[12.0, -31.0]])
