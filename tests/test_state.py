@@ -51,7 +51,7 @@ def test_overlap_allowed_when_collisions_are_off():
 
 def test_particle_outside_the_vessel_is_named():
     p = Particles(position=[[0.0, 0.0], [9.9, 0.0]], radius=0.25)
-    with pytest.raises(InputError, match="particle 1 .* outside"):
+    with pytest.raises(InputError, match=r"particle 1 .* outside"):
         Simulation(Box(20, 20), p)
 
 

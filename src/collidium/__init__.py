@@ -13,8 +13,8 @@ from collidium.state import Particles
 
 __all__ = [
     "Box",
-    "Counters",
     "Coulomb",
+    "Counters",
     "Energy",
     "InputError",
     "Particles",

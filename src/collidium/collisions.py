@@ -37,7 +37,12 @@ class Drift(Protocol):
 
 def make_drift(mode: CollisionMode) -> Drift:
     """The drift object for a collision mode name."""
-    return {"exact": ExactCollisions, "step": StepCollisions, "off": NoCollisions}[mode]()
+    modes: dict[str, type[ExactCollisions | StepCollisions | NoCollisions]] = {
+        "exact": ExactCollisions,
+        "step": StepCollisions,
+        "off": NoCollisions,
+    }
+    return modes[mode]()
 
 
 class _Grid:

@@ -11,7 +11,7 @@ from typing import Literal
 import numpy as np
 
 from collidium.errors import InputError
-from collidium.state import FloatArray
+from collidium.state import FloatArray, IntArray
 
 Boundary = Literal["reflecting", "periodic"]
 BOUNDARIES: tuple[Boundary, ...] = ("reflecting", "periodic")
@@ -59,7 +59,7 @@ class Box:
         """Area in m^2."""
         return self.width * self.height
 
-    def outside(self, position: FloatArray, radius: FloatArray) -> FloatArray:
+    def outside(self, position: FloatArray, radius: FloatArray) -> IntArray:
         """Indices of particles not inside the vessel.
 
         Parameters
@@ -81,7 +81,7 @@ class Box:
         else:
             reach = np.abs(position) + radius[:, None] - half
         bad = (reach > OUTSIDE_TOLERANCE * half).any(axis=1) | ~np.isfinite(position).all(axis=1)
-        return np.flatnonzero(bad)
+        return np.flatnonzero(bad).astype(np.int64)
 
     def check_fits(self, radius: FloatArray) -> None:
         """Refuse disks too large for the box (periodic: a diameter of at most half a side, so a
@@ -91,7 +91,9 @@ class Box:
         r = float(radius.max())
         limit = min(self.width, self.height)
         if self.periodic and 4 * r > limit:
-            raise InputError("radius", f"diameter {2 * r} too large for a periodic box of side {limit}")
+            raise InputError(
+                "radius", f"diameter {2 * r} too large for a periodic box of side {limit}"
+            )
         if 2 * r > limit:
             raise InputError("radius", f"diameter {2 * r} does not fit in a box of side {limit}")
 

@@ -16,7 +16,9 @@ from collidium.state import FloatArray, Particles
 
 @dataclass(frozen=True)
 class Coulomb:
-    """Coulomb interaction ``F = k q_i q_j r / (r^2 + eps^2)^(3/2)``, ``U = k q_i q_j / sqrt(r^2 + eps^2)``.
+    """Coulomb interaction (seed eq. 9-10, softened).
+
+    ``F = k q_i q_j r / (r^2 + eps^2)^(3/2)`` and ``U = k q_i q_j / sqrt(r^2 + eps^2)``.
 
     Parameters
     ----------
@@ -47,7 +49,9 @@ class Coulomb:
         if cap is not None and (not math.isfinite(cap) or cap <= 0):
             raise InputError("forces.coulomb.max_acceleration", f"must be > 0, got {cap!r}")
 
-    def compute(self, particles: Particles, box: Box, force: FloatArray, energy: FloatArray) -> None:
+    def compute(
+        self, particles: Particles, box: Box, force: FloatArray, energy: FloatArray
+    ) -> None:
         """Write this force on each particle into ``force`` (N, 2), in N, and each particle's share
         of the pair energy into ``energy`` (N,), in J (their sum is the potential energy)."""
         coulomb_direct(
@@ -68,7 +72,6 @@ class Coulomb:
         if self.max_acceleration is not None:
             out["max_acceleration"] = self.max_acceleration
         return out
-
 
 
 class ForceField:

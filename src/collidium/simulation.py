@@ -188,8 +188,9 @@ class Simulation:
         if index < 0:
             return
         what = "a non-finite position or velocity" if reason == 1 else "left the vessel"
-        bad = np.flatnonzero(~np.isfinite(p.position).all(1) | ~np.isfinite(p.velocity).all(1))
-        if reason == 2:
+        if reason == 1:
+            bad = np.flatnonzero(~np.isfinite(p.position).all(1) | ~np.isfinite(p.velocity).all(1))
+        else:
             bad = box.outside(p.position, p.radius)
         listed = ", ".join(str(int(i)) for i in bad[:10]) + (" ..." if bad.size > 10 else "")
         raise SimulationError(

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import jittered_lattice
 
 from collidium import Box, Particles, Simulation
 from collidium.kernels import reference
 from collidium.kernels.events import contact_delay
+from conftest import jittered_lattice
 
 
 def test_contact_delay_head_on():

@@ -14,7 +14,7 @@ def _coulomb(position, charge, k=5.0, eps2=0.0, size=None):
     force = np.empty((n, 2))
     energy = np.empty(n)
     periodic = size is not None
-    w, h = (size if periodic else (0.0, 0.0))
+    w, h = size if periodic else (0.0, 0.0)
     coulomb_direct(position, charge, k, eps2, w, h, periodic, force, energy)
     return force, energy
 

@@ -49,7 +49,7 @@ def neighbour_table(ncx: int, ncy: int, periodic: bool) -> tuple[np.ndarray, np.
 @numba.njit(cache=True, inline="always")
 def cell_index(x: float, half: float, cell: float, count: int) -> int:
     """Index along one axis of the cell holding coordinate ``x`` (clamped to the grid)."""
-    k = int(math.floor((x + half) / cell))
+    k = math.floor((x + half) / cell)
     return min(max(k, 0), count - 1)
 
 

@@ -441,4 +441,3 @@ def synchronise(
         lag = now - stamp[i]
         out[i, 0] = position[i, 0] + velocity[i, 0] * lag
         out[i, 1] = position[i, 1] + velocity[i, 1] * lag
-

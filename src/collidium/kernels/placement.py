@@ -54,8 +54,8 @@ def place_disks(
         x = candidates[m, 0]
         y = candidates[m, 1]
         r = radius[placed]
-        cx = min(max(int(math.floor((x - lo[0]) / cell)), 0), ncx - 1)
-        cy = min(max(int(math.floor((y - lo[1]) / cell)), 0), ncy - 1)
+        cx = min(max(math.floor((x - lo[0]) / cell), 0), ncx - 1)
+        cy = min(max(math.floor((y - lo[1]) / cell), 0), ncy - 1)
         free = True
         for oy in range(max(cy - 1, 0), min(cy + 2, ncy)):
             for ox in range(max(cx - 1, 0), min(cx + 2, ncx)):

@@ -107,7 +107,9 @@ def event_drift(
     pairs = walls = 0
     while True:
         t_pair, i, j = _next_contact(position, velocity, radius, 2 * half, periodic)
-        t_wall, k, d = (math.inf, -1, -1) if periodic else _next_wall(position, velocity, radius, half)
+        t_wall, k, d = (
+            (math.inf, -1, -1) if periodic else _next_wall(position, velocity, radius, half)
+        )
         best = min(t_pair, t_wall)
         if now + best > duration:
             position += velocity * (duration - now)

@@ -38,13 +38,10 @@ def fold(x: float, v: float, lo: float, hi: float) -> tuple[float, float, int]:
         return lo, -v, 1
     # Distance travelled past the first wall met; every further span is one more bounce.
     overshoot = x - hi if above else lo - x
-    bounces = int(math.ceil(overshoot / span))
+    bounces = math.ceil(overshoot / span)
     rest = overshoot - (bounces - 1) * span
     back_from_first = bounces % 2 == 1
-    if above == back_from_first:
-        x = hi - rest
-    else:
-        x = lo + rest
+    x = hi - rest if above == back_from_first else lo + rest
     if back_from_first:
         v = -v
     return min(max(x, lo), hi), v, bounces
