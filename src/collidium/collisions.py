@@ -124,6 +124,8 @@ class ExactCollisions:
         self._written: FloatArray | None = None  # positions last written to the particles
         #: Events processed so far (collisions, wall hits, cell crossings, stale events).
         self.events = 0
+        #: Times the event queue was built from scratch.
+        self.rebuilds = 0
 
     def _is_current(self, particles: Particles) -> bool:
         return (
@@ -168,6 +170,7 @@ class ExactCollisions:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
         if not self._is_current(particles):
             self._state = self._rebuild(particles, box, now)
+            self.rebuilds += 1
         s = self._state
         assert s is not None
         until = now + dt

@@ -100,12 +100,12 @@ class Simulation:
         _check_setup(container, particles, forces, dt, collisions)
         self.container = container
         self.particles = particles
-        self.dt = float(dt)
+        self._dt = float(dt)
+        self._time_origin = (0.0, 0)  # (time, steps) when dt was last set
         self.collisions: CollisionMode = collisions
         self.seed = seed
         self.rng = np.random.default_rng(seed)
         self.name = name or "custom"
-        self.time = 0.0
         self.steps = 0
         self.observers: list[Observer] = []
         self._attached: set[int] = set()
@@ -119,6 +119,24 @@ class Simulation:
             particles.image += np.rint((particles.position - wrapped) / size).astype(np.int64)
             particles.position[...] = wrapped
         _check_placement(container, particles, collisions)
+
+    @property
+    def dt(self) -> float:
+        """Time step in s; may be changed between runs."""
+        return self._dt
+
+    @dt.setter
+    def dt(self, value: float) -> None:
+        _check_dt(value)
+        self._time_origin = (self.time, self.steps)
+        self._dt = float(value)
+
+    @property
+    def time(self) -> float:
+        """Simulated time in s: counted in whole steps, ``t0 + (steps - k0) * dt``, so that it
+        carries no accumulated round-off."""
+        t0, k0 = self._time_origin
+        return t0 + (self.steps - k0) * self._dt
 
     @property
     def forces(self) -> tuple[Coulomb, ...]:
@@ -171,7 +189,6 @@ class Simulation:
             self.particles, self.container, self._field, self._drift, self.time, self.dt,
             self._tally,
         )  # fmt: skip
-        self.time += self.dt
         self.steps += 1
         self._audit()
         for observer in self.observers:
@@ -276,11 +293,15 @@ def _check_setup(
     for k, force in enumerate(forces):
         if not isinstance(force, Coulomb):
             raise InputError(f"forces.{k}", f"unknown force {type(force).__name__}")
-    if isinstance(dt, bool) or not isinstance(dt, int | float) or not math.isfinite(dt) or dt <= 0:
-        raise InputError("dt", f"must be a finite number > 0, got {dt!r}")
+    _check_dt(dt)
     if collisions not in COLLISION_MODES:
         raise InputError("collisions", f"must be one of {COLLISION_MODES}, got {collisions!r}")
     container.check_fits(particles.radius)
+
+
+def _check_dt(dt: float) -> None:
+    if isinstance(dt, bool) or not isinstance(dt, int | float) or not math.isfinite(dt) or dt <= 0:
+        raise InputError("dt", f"must be a finite number > 0, got {dt!r}")
 
 
 def _check_placement(container: Box, particles: Particles, collisions: str) -> None:

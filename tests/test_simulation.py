@@ -1,0 +1,222 @@
+"""Whole runs: the seed's exact cases, conservation, no escapes, reproducibility."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import collidium as cd
+from collidium.kernels.cells import first_overlap, grid_shape
+from collidium.observers import Every
+
+
+class OverlapWatch:
+    """Observer: the worst overlap (relative to contact distance) seen at any report."""
+
+    def __init__(self) -> None:
+        self.trigger = Every(1)
+        self.reports = 0
+        self.first_pair = (-1, -1)
+
+    def attach(self, sim: cd.Simulation) -> None:
+        self.update(sim)
+
+    def update(self, sim: cd.Simulation) -> None:
+        p, box = sim.particles, sim.container
+        shape = grid_shape(box.width, box.height, 2 * p.radius.max(), p.n)
+        pair = first_overlap(p.position, p.radius, box.width, box.height, box.periodic, *shape)
+        if pair != (-1, -1) and self.first_pair == (-1, -1):
+            self.first_pair = pair
+        self.reports += 1
+
+
+class Trace:
+    """Observer: positions of all particles after every step."""
+
+    def __init__(self) -> None:
+        self.trigger = Every(1)
+        self.times: list[float] = []
+        self.positions: list[np.ndarray] = []
+        self.totals: list[float] = []
+
+    def attach(self, sim: cd.Simulation) -> None:
+        self.update(sim)
+
+    def update(self, sim: cd.Simulation) -> None:
+        self.times.append(sim.time)
+        self.positions.append(sim.particles.position.copy())
+        self.totals.append(sim.energy().total)
+
+
+def test_head_on_preset_swaps_velocities():
+    sim = cd.load("head-on").run(time=0.2)  # contact at t = 0.15 s
+    np.testing.assert_array_equal(sim.particles.velocity, [[-5.0, 0.0], [5.0, 0.0]])
+    assert sim.counters.pair_collisions == 1
+
+
+def test_right_angle_preset_leaves_left_and_down():
+    sim = cd.load("right-angle").run(time=0.5)
+    (vx0, _vy0), (_vx1, vy1) = sim.particles.velocity
+    # The top particle leaves to the left, the right one downwards (seed 3.1.2).
+    assert vx0 < 0 and vy1 < 0
+    assert sim.counters.pair_collisions == 1
+    np.testing.assert_allclose(sim.momentum(), [-5.0, -5.0], rtol=0, atol=1e-14)
+    assert sim.energy().total == pytest.approx(25.0, rel=1e-14)
+
+
+@pytest.mark.slow
+def test_force_free_gas_conserves_energy_exactly_with_no_overlap_or_escape():
+    sim = cd.load("gas")
+    watch = OverlapWatch()
+    sim.observers.append(watch)
+    e0 = sim.energy().total
+    sim.run(time=20.0)
+    assert watch.reports == 2001
+    assert watch.first_pair == (-1, -1)
+    assert sim.escaped() == 0
+    # Each collision is exact; only round-off accumulates.
+    assert abs(sim.energy().total - e0) / e0 <= 1e-12
+    assert sim.counters.pair_collisions > 10_000
+
+
+def test_step_mode_loses_no_particle_in_pool_break():
+    sim = cd.load("pool-break", collisions="step")
+    n = sim.particles.n
+    sim.run(time=10.0)  # the audit would stop the run if any particle left the table
+    assert sim.particles.n == n == 225
+    assert sim.escaped() == 0
+    assert sim.counters.pair_collisions > 100
+
+
+def _max_energy_error(name: str, dt: float, time: float) -> float:
+    sim = cd.load(name, dt=dt)
+    drift = cd.observers.EnergyDrift()
+    sim.observers.append(drift)
+    sim.run(time=time)
+    return drift.max_rel_drift
+
+
+@pytest.mark.parametrize("name", ["orbit", "charged-like"])
+def test_halving_dt_cuts_the_energy_error_about_four_times(name):
+    coarse = _max_energy_error(name, 0.02, 10.0)
+    fine = _max_energy_error(name, 0.01, 10.0)
+    # Leapfrog: bounded energy error of order dt^2, so the ratio is 4 up to O(dt^2) corrections.
+    assert 3.5 < coarse / fine < 4.5
+
+
+def test_charged_like_never_touch():
+    sim = cd.load("charged-like")
+    trace = Trace()
+    sim.observers.append(trace)
+    sim.run(time=10.0)
+    gaps = [np.linalg.norm(p[1] - p[0]) for p in trace.positions]
+    # Energy: 4 J kinetic + 0.5 J potential = k q^2 / r_min  ->  r_min = 5 / 4.5 m.
+    assert min(gaps) == pytest.approx(5.0 / 4.5, rel=1e-3)
+    assert min(gaps) > 0.5
+    assert sim.counters.pair_collisions == 0
+
+
+def _kepler_period(sim: cd.Simulation) -> float:
+    p = sim.particles
+    mu = p.mass[0] * p.mass[1] / (p.mass[0] + p.mass[1])
+    r = np.linalg.norm(p.position[1] - p.position[0])
+    v = np.linalg.norm(p.velocity[1] - p.velocity[0])
+    strength = -sim.forces[0].k * p.charge[0] * p.charge[1]
+    energy = 0.5 * mu * v**2 - strength / r
+    semi_major = strength / (2 * -energy)
+    return 2 * math.pi * math.sqrt(mu * semi_major**3 / strength)
+
+
+def _measured_period(trace: Trace) -> float:
+    separation = np.array([p[1] - p[0] for p in trace.positions])
+    angle = np.unwrap(np.arctan2(separation[:, 1], separation[:, 0]))
+    swept = np.abs(angle - angle[0])
+    times = np.array(trace.times)
+    k = int(np.argmax(swept >= 2 * math.pi))
+    # Linear interpolation between the two reports around one full turn.
+    return float(np.interp(2 * math.pi, swept[k - 1 : k + 1], times[k - 1 : k + 1]))
+
+
+@pytest.mark.parametrize("dt", [0.01, 0.005])
+def test_orbit_period_matches_kepler(dt):
+    sim = cd.load("orbit", dt=dt)
+    expected = _kepler_period(sim)
+    assert expected == pytest.approx(9.4, abs=0.1)  # the seed's ellipse
+    trace = Trace()
+    sim.observers.append(trace)
+    sim.run(time=12.0)
+    measured = _measured_period(trace)
+    # Leapfrog's period error is O((omega dt)^2) with omega <= 2 rad/s at periapsis.
+    assert abs(measured - expected) / expected < (2.0 * dt) ** 2
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", cd.presets())
+def test_every_preset_runs_ten_seconds_with_nothing_outside(name):
+    sim = cd.load(name)
+    n = sim.particles.n
+    sim.run(time=10.0)
+    assert sim.escaped() == 0
+    assert sim.particles.n == n
+    assert np.isfinite(sim.particles.position).all()
+
+
+@pytest.mark.parametrize("name", ["gas", "charged-gas", "pool-break"])
+def test_same_seed_gives_a_bitwise_identical_state(name):
+    a = cd.load(name, seed=7).run(time=1.0)
+    b = cd.load(name, seed=7).run(time=1.0)
+    assert a.particles.position.tobytes() == b.particles.position.tobytes()
+    assert a.particles.velocity.tobytes() == b.particles.velocity.tobytes()
+
+
+def test_different_seed_gives_a_different_gas():
+    a = cd.load("gas", seed=1)
+    b = cd.load("gas", seed=2)
+    assert not np.array_equal(a.particles.position, b.particles.position)
+
+
+def test_radius_zero_particles_pass_through_each_other_but_reflect_from_walls():
+    sim = cd.load("charged-no-collisions", k=0.0)  # no force: straight lines
+    sim.run(time=10.0)
+    assert sim.counters.pair_collisions == 0
+    # Each travels 2 m/s * 10 s = 20 m from x = -5 or 5: through the other, off the far wall.
+    assert sim.counters.wall_collisions == 2
+    np.testing.assert_allclose(sim.particles.position[:, 0], [5.0, -5.0], atol=1e-12)
+
+
+def test_periodic_gas_conserves_momentum_and_keeps_unwrapped_paths():
+    base = cd.load("gas", n=100, seed=4)
+    p = base.particles
+    sim = cd.Simulation(cd.Box(20, 20, "periodic"), p.copy(), dt=0.05)
+    p0 = sim.momentum()
+    e0 = sim.energy().total
+    start = sim.unwrapped_position()
+    sim.run(time=5.0)
+    np.testing.assert_allclose(sim.momentum(), p0, rtol=0, atol=1e-12 * np.abs(p.velocity).sum())
+    assert abs(sim.energy().total - e0) / e0 < 1e-13
+    assert sim.escaped() == 0
+    travelled = np.linalg.norm(sim.unwrapped_position() - start, axis=1)
+    assert travelled.max() > 20.0  # some particles went round the box
+    assert (np.abs(sim.particles.image) > 0).any()
+
+
+@pytest.mark.parametrize("mode", ["exact", "step", "off"])
+def test_all_modes_keep_particles_inside(mode):
+    sim = cd.load("gas", n=300, seed=5, collisions=mode).run(time=3.0)
+    assert sim.escaped() == 0
+
+
+def test_nan_in_a_run_stops_it_naming_the_particles():
+    sim = cd.load("head-on")
+    sim.run(time=0.01)
+    sim.particles.velocity[1, 0] = np.nan
+    with pytest.raises(cd.SimulationError, match=r"step 2 .*particle\(s\) 1 "):
+        sim.run(time=0.01)
+
+
+def test_time_and_steps_are_exclusive():
+    sim = cd.load("head-on")
+    with pytest.raises(cd.InputError, match="exactly one"):
+        sim.run(time=1.0, steps=3)
