@@ -7,7 +7,10 @@
 
 from collidium.containers import Box
 from collidium.errors import InputError, SimulationError
+from collidium import observers
 from collidium.forces import Coulomb
+from collidium.loading import load
+from collidium.presets import presets
 from collidium.simulation import Counters, Energy, Simulation
 from collidium.state import Particles
 
@@ -20,5 +23,8 @@ __all__ = [
     "Particles",
     "Simulation",
     "SimulationError",
+    "load",
+    "observers",
+    "presets",
 ]
 __version__ = "0.1.0"

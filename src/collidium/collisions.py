@@ -31,8 +31,20 @@ COLLISION_MODES: tuple[CollisionMode, ...] = ("exact", "step", "off")
 class Drift(Protocol):
     """A drift mode: moves particles over one step and counts collisions."""
 
-    def drift(self, particles: Particles, box: Box, now: float, dt: float, tally: IntArray) -> None:
-        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
+    def drift(
+        self,
+        particles: Particles,
+        box: Box,
+        now: float,
+        dt: float,
+        tally: IntArray,
+        acceleration: FloatArray | None = None,
+    ) -> None:
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place.
+
+        ``acceleration`` (N, 2), in m/s^2, is that of the step's half kicks when forces act; a mode
+        may use it to time collisions within the step consistently with the kicks.
+        """
 
 
 def make_drift(mode: CollisionMode) -> Drift:
@@ -43,6 +55,9 @@ def make_drift(mode: CollisionMode) -> Drift:
         "off": NoCollisions,
     }
     return modes[mode]()
+
+
+_NO_ACCELERATION = np.empty((0, 2))
 
 
 class _Grid:
@@ -75,7 +90,15 @@ def _free_flight(particles: Particles, box: Box, dt: float, tally: IntArray) -> 
 class NoCollisions:
     """Pass-through: free flight with exact wall reflection (or periodic wrapping)."""
 
-    def drift(self, particles: Particles, box: Box, now: float, dt: float, tally: IntArray) -> None:
+    def drift(
+        self,
+        particles: Particles,
+        box: Box,
+        now: float,
+        dt: float,
+        tally: IntArray,
+        acceleration: FloatArray | None = None,
+    ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
         _free_flight(particles, box, dt, tally)
 
@@ -91,7 +114,15 @@ class StepCollisions:
         self._grid: _Grid | None = None
         self._pairs = np.empty(64, dtype=np.int64)
 
-    def drift(self, particles: Particles, box: Box, now: float, dt: float, tally: IntArray) -> None:
+    def drift(
+        self,
+        particles: Particles,
+        box: Box,
+        now: float,
+        dt: float,
+        tally: IntArray,
+        acceleration: FloatArray | None = None,
+    ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
         _free_flight(particles, box, dt, tally)
         if self._grid is None or self._grid.cell_of.shape[0] != particles.n:
@@ -166,7 +197,15 @@ class ExactCollisions:
         )  # fmt: skip
         return s
 
-    def drift(self, particles: Particles, box: Box, now: float, dt: float, tally: IntArray) -> None:
+    def drift(
+        self,
+        particles: Particles,
+        box: Box,
+        now: float,
+        dt: float,
+        tally: IntArray,
+        acceleration: FloatArray | None = None,
+    ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
         if not self._is_current(particles):
             self._state = self._rebuild(particles, box, now)
@@ -179,7 +218,8 @@ class ExactCollisions:
             particles.image, s["geometry"], s["grid"], s["cell_of"], s["head"], s["next"],
             s["prev"], s["cells"], s["shifts"], s["collisions"], s["event_time"],
             s["event_kind"], s["event_other"], s["event_stamp"], s["heap"], s["heap_keys"],
-            s["heap_where"], tally,
+            s["heap_where"], tally, _NO_ACCELERATION if acceleration is None else acceleration,
+            now + 0.5 * dt,
         )  # fmt: skip
         events.synchronise(until, s["position"], s["velocity"], s["stamp"], particles.position)
         particles.velocity[...] = s["velocity"]

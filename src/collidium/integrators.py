@@ -34,6 +34,6 @@ class Leapfrog:
         """
         if field.active:
             particles.velocity += (0.5 * dt) * field.acceleration
-        drift.drift(particles, box, now, dt, tally)
+        drift.drift(particles, box, now, dt, tally, field.acceleration if field.active else None)
         if field.active:
             particles.velocity += (0.5 * dt) * field.evaluate(particles, box)
