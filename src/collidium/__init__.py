@@ -5,9 +5,9 @@
 >>> sim.run(time=5.0).energy().total  # doctest: +SKIP
 """
 
+from collidium import observers
 from collidium.containers import Box
 from collidium.errors import InputError, SimulationError
-from collidium import observers
 from collidium.forces import Coulomb
 from collidium.loading import load
 from collidium.presets import presets

@@ -1,0 +1,312 @@
+"""The ``collidium`` command line: list presets, run a scenario, export a preset as TOML.
+
+Bad input of any kind prints one line ``error: <field>: <reason>`` on stderr and exits with
+status 2 (no traceback, nothing half-written); a run that goes wrong exits with status 1.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import math
+import os
+import sys
+import tempfile
+import time as clock
+import tomllib
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from pydantic import ValidationError
+
+from collidium.errors import InputError, SimulationError
+
+app = typer.Typer(
+    name="collidium",
+    help="Particles in a 2D vessel: exact elastic collisions, Coulomb forces, leapfrog.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+SetOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--set",
+        metavar="KEY=VALUE",
+        help="Override a preset parameter (n=500) or a scenario field (run.dt=0.002); "
+        "the value is read as TOML (a bare word is a string). Repeatable.",
+    ),
+]
+
+
+@app.command("presets")
+def presets_command(
+    as_json: Annotated[bool, typer.Option("--json", help="Print a JSON list.")] = False,
+) -> None:
+    """List the presets (the seed report's configurations)."""
+    from collidium.presets import describe_presets
+
+    entries = describe_presets()
+    if as_json:
+        typer.echo(json.dumps(entries, indent=2))
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title="collidium presets")
+    for column in ("name", "seed §", "description", "parameters"):
+        table.add_column(column)
+    for entry in entries:
+        parameters = ", ".join(f"{k}={v}" for k, v in entry["parameters"].items())
+        table.add_row(entry["name"], entry["section"], entry["description"], parameters)
+    Console().print(table)
+
+
+@app.command("run")
+def run_command(
+    scenario: Annotated[str, typer.Argument(help="Preset name or scenario .toml file.")],
+    time: Annotated[
+        float | None, typer.Option("--time", help="Duration in s (default: the scenario's).")
+    ] = None,
+    steps: Annotated[int | None, typer.Option("--steps", help="Number of steps.")] = None,
+    dt: Annotated[float | None, typer.Option("--dt", help="Time step in s.")] = None,
+    seed: Annotated[int | None, typer.Option("--seed", help="Random seed.")] = None,
+    overrides: SetOption = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Run a preset or scenario file and print a summary."""
+    from collidium.loading import load_scenario
+    from collidium.observers import EnergyDrift
+
+    if time is not None and steps is not None:
+        raise InputError("--time", "give --time or --steps, not both")
+    values = parse_settings(overrides or [])
+    values |= {k: v for k, v in (("dt", dt), ("seed", seed)) if v is not None}
+    spec = load_scenario(scenario, **values)
+    sim = spec.build()
+    drift = EnergyDrift()
+    sim.observers.append(drift)
+    duration = spec.run.time if time is None and steps is None else time
+    progress = not as_json and sys.stderr.isatty()
+    start = clock.perf_counter()
+    sim.run(time=duration, steps=steps, progress=progress)
+    wall = clock.perf_counter() - start
+    summary = run_summary(sim, drift, wall)
+    if as_json:
+        typer.echo(json.dumps(summary))
+    else:
+        _print_summary(summary)
+
+
+@app.command("export")
+def export_command(
+    preset: Annotated[str, typer.Argument(help="Preset name (or a scenario .toml file).")],
+    overrides: SetOption = None,
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Write to this file (default stdout).")
+    ] = None,
+) -> None:
+    """Write a preset's scenario as editable TOML."""
+    from collidium.loading import load_scenario
+
+    text = load_scenario(preset, **parse_settings(overrides or [])).to_toml()
+    if output is None:
+        sys.stdout.write(text)
+    else:
+        write_atomically(output, text)
+
+
+def parse_settings(items: Sequence[str]) -> dict[str, Any]:
+    """``["n=500", "run.dt=0.002", "collisions=step"]`` -> ``{"n": 500, ...}``.
+
+    Values are read as TOML values (``500`` int, ``2.5`` float, ``true``, ``[1, 2]``); anything
+    that is not valid TOML is kept as a string (``step``).
+    """
+    values: dict[str, Any] = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise InputError("--set", f"expected KEY=VALUE, got {item!r}")
+        text = text.strip()
+        try:
+            values[key] = tomllib.loads(f"value = {text}")["value"]
+        except tomllib.TOMLDecodeError:
+            values[key] = text
+    return values
+
+
+def write_atomically(path: Path, text: str) -> None:
+    """Write ``text`` to a temporary file beside ``path``, then rename it over ``path``."""
+    folder = path.parent if str(path.parent) else Path(".")
+    try:
+        handle, temporary = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError as exc:
+        raise InputError(str(path), f"cannot write: {exc.strerror or exc}") from None
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as stream:
+            stream.write(text)
+        os.chmod(temporary, 0o666 & ~_umask())
+        os.replace(temporary, path)
+    except OSError as exc:
+        Path(temporary).unlink(missing_ok=True)
+        raise InputError(str(path), f"cannot write: {exc.strerror or exc}") from None
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def _umask() -> int:
+    """The process umask (read by setting and restoring it)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def run_summary(sim: Any, drift: Any, wall_seconds: float) -> dict[str, Any]:
+    """Plain numbers describing a finished run (the ``--json`` object).
+
+    Parameters
+    ----------
+    sim : Simulation
+        The simulation after its run.
+    drift : EnergyDrift
+        The observer attached for the run.
+    wall_seconds : float
+        Elapsed real time of the run in s.
+    """
+    energy = sim.energy()
+    counters = sim.counters
+    return {
+        "scenario": sim.name,
+        "n": int(sim.particles.n),
+        "time": float(sim.time),
+        "steps": int(sim.steps),
+        "dt": float(sim.dt),
+        "wall_seconds": wall_seconds,
+        "energy": {
+            "kinetic": float(energy.kinetic),
+            "potential": float(energy.potential),
+            "total": float(energy.total),
+            "initial_total": _finite_or_none(drift.initial_total),
+            "max_rel_drift": _finite_or_none(drift.max_rel_drift),
+        },
+        "momentum": [float(x) for x in sim.momentum()],
+        "collisions": {
+            "pair": int(counters.pair_collisions),
+            "wall": int(counters.wall_collisions),
+        },
+        "escaped": int(sim.escaped()),
+    }
+
+
+def _finite_or_none(value: float) -> float | None:
+    """JSON has no NaN: a non-finite number becomes null."""
+    return float(value) if math.isfinite(value) else None
+
+
+def _print_summary(summary: dict[str, Any]) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    energy = summary["energy"]
+    drift = energy["max_rel_drift"]
+    rows = [
+        ("particles", f"{summary['n']}"),
+        ("simulated time", f"{summary['time']:.6g} s in {summary['steps']} steps"),
+        ("wall time", f"{summary['wall_seconds']:.3g} s"),
+        ("kinetic energy", f"{energy['kinetic']:.10g} J"),
+        ("potential energy", f"{energy['potential']:.10g} J"),
+        ("total energy", f"{energy['total']:.10g} J"),
+        ("max relative energy drift", "n/a" if drift is None else f"{drift:.3g}"),
+        ("momentum", "({:.6g}, {:.6g}) kg m/s".format(*summary["momentum"])),
+        ("pair collisions", f"{summary['collisions']['pair']}"),
+        ("wall collisions", f"{summary['collisions']['wall']}"),
+        ("escaped", f"{summary['escaped']}"),
+    ]
+    table = Table(title=f"collidium run: {summary['scenario']}", show_header=False)
+    table.add_column("quantity")
+    table.add_column("value", justify="right")
+    for row in rows:
+        table.add_row(*row)
+    Console().print(table)
+
+
+# --- entry point: every error becomes one line ---------------------------------------------------
+
+
+def _click_exceptions() -> tuple[type[Exception], type[Exception]]:
+    """``(ClickException, UsageError)`` of the click that typer uses (vendored or not)."""
+    for module in ("typer._click.exceptions", "click.exceptions"):
+        try:
+            found = importlib.import_module(module)
+        except ImportError:
+            continue
+        return found.ClickException, found.UsageError
+    raise ImportError("typer without click")  # pragma: no cover
+
+
+def _usage_line(exc: Exception) -> str:
+    """``field: reason`` for a click usage error (the option or argument named when known)."""
+    message = str(getattr(exc, "message", "") or exc).strip()
+    param = getattr(exc, "param", None)
+    option = getattr(exc, "option_name", None)
+    if param is not None:
+        names = getattr(param, "opts", None) or [getattr(param, "name", None) or "argument"]
+        field = str(max(names, key=len))
+        if type(exc).__name__ == "MissingParameter":
+            field = field if field.startswith("-") else field.upper()
+            message = "required but not given"
+    elif option:
+        field = str(option)
+        message = message.replace(f"No such option: {option}", "no such option")
+    elif message.lower().startswith("no such command"):
+        field, message = (
+            "command",
+            message[len("no such command") :].strip(" .") + " is not a command",
+        )
+        message += "; choose from: presets, run, export"
+    else:
+        field = "usage"
+    message = " ".join(message.split()) or type(exc).__name__
+    return f"{field}: {message[0].lower()}{message[1:]}"
+
+
+def _fail(line: str, code: int) -> int:
+    sys.stderr.write(f"error: {line}\n")
+    sys.stderr.flush()
+    return code
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Console entry point. Returns the exit status (0 ok, 1 failed run, 2 bad input)."""
+    click_exception, usage_error = _click_exceptions()
+    command = typer.main.get_command(app)
+    try:
+        result = command.main(
+            args=list(sys.argv[1:] if argv is None else argv),
+            prog_name="collidium",
+            standalone_mode=False,
+        )
+    except InputError as exc:
+        return _fail(str(exc), 2)
+    except ValidationError as exc:
+        from collidium.scenario import describe
+
+        return _fail(describe(exc), 2)
+    except SimulationError as exc:
+        return _fail(f"run: {exc}", 1)
+    except usage_error as exc:
+        if type(exc).__name__ == "NoArgsIsHelpError":  # bare `collidium`: the help is the answer
+            sys.stdout.write(str(getattr(exc, "message", "")))
+            return 0
+        return _fail(_usage_line(exc), 2)
+    except click_exception as exc:
+        message = exc.format_message() if hasattr(exc, "format_message") else str(exc)
+        return _fail(f"input: {message}", 2)
+    except (typer.Abort, KeyboardInterrupt):
+        return _fail("interrupted", 130)
+    return result if isinstance(result, int) else 0

@@ -1,0 +1,246 @@
+"""Initial conditions: random non-overlapping positions, random velocities and charges, the rack.
+
+Every generator that draws random numbers takes a `numpy.random.Generator` and is deterministic
+given its state: the same generator state gives bitwise-identical arrays.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from collidium.errors import InputError
+from collidium.kernels.placement import place_disks
+from collidium.state import FloatArray
+
+#: Candidate batches tried by `random_positions` before it gives up.
+MAX_BATCHES = 200
+
+#: Densest packing fraction of equal disks in the plane (hexagonal), pi / (2 sqrt(3)).
+HEXAGONAL_PACKING = math.pi / (2.0 * math.sqrt(3.0))
+
+
+def random_positions(
+    n: int,
+    radius: float | ArrayLike,
+    width: float,
+    height: float,
+    rng: np.random.Generator,
+    *,
+    existing: ArrayLike | None = None,
+    existing_radius: ArrayLike | None = None,
+    field: str = "particles.n",
+    max_batches: int = MAX_BATCHES,
+) -> FloatArray:
+    """Uniform random centres of ``n`` non-overlapping disks inside a box centred on the origin.
+
+    Candidates are drawn in batches from ``rng`` and accepted in order when they overlap no disk
+    accepted before (random sequential adsorption, `collidium.kernels.placement.place_disks`).
+
+    Parameters
+    ----------
+    n : int
+        Number of disks to place (>= 0).
+    radius : float or array_like, shape (n,)
+        Radii in m (>= 0). Every centre is drawn in ``[-W/2 + r, W/2 - r] x [-H/2 + r, H/2 - r]``
+        with ``r`` the largest radius, so every disk lies fully inside the box (also in a periodic
+        box, where no disk then straddles the boundary).
+    width, height : float
+        Box sides W and H in m.
+    rng : numpy.random.Generator
+        Source of the candidates.
+    existing : array_like, shape (M, 2), optional
+        Centres in m of disks already in the box that the new ones must not overlap.
+    existing_radius : float or array_like, shape (M,), optional
+        Radii in m of the existing disks (default 0).
+    field : str
+        Field named in the error when the disks do not fit.
+    max_batches : int
+        Batches of candidates tried before giving up.
+
+    Returns
+    -------
+    ndarray, shape (n, 2)
+        Centres in m.
+
+    Raises
+    ------
+    InputError
+        When the disks do not fit in the box, or ``n`` disks could not be placed after
+        ``max_batches`` batches (too dense for random placement).
+    """
+    radii = _radii(radius, n, "particles.radius")
+    old = np.zeros((0, 2)) if existing is None else np.asarray(existing, np.float64).reshape(-1, 2)
+    m = old.shape[0]
+    old_radii = _radii(0.0 if existing_radius is None else existing_radius, m, "existing_radius")
+    r_max = float(radii.max(initial=0.0))
+    if n == 0:
+        return np.zeros((0, 2))
+    if 2.0 * r_max > min(width, height):
+        raise InputError(
+            field, f"disks of radius {r_max:g} m do not fit in a {width:g} x {height:g} box"
+        )
+    _check_density(n, radii, old_radii, width, height, field)
+
+    all_radii = np.concatenate([old_radii, radii])
+    position = np.zeros((m + n, 2))
+    position[:m] = old
+    cell = max(2.0 * float(all_radii.max(initial=0.0)), math.sqrt(width * height / (m + n)))
+    ncx = max(1, math.ceil(width / cell))
+    ncy = max(1, math.ceil(height / cell))
+    lo = np.array([-0.5 * width, -0.5 * height])
+    head, next_ = _cell_lists(old, lo, cell, ncx, ncy, m + n)
+    low = lo + r_max
+    high = -lo - r_max
+    placed = m
+    for _ in range(max_batches):
+        batch = max(256, 2 * (m + n - placed))
+        candidates = rng.uniform(low, high, size=(batch, 2))
+        placed = place_disks(
+            candidates, all_radii, placed, position, lo, cell, ncx, ncy, head, next_
+        )
+        if placed == m + n:
+            return position[m:].copy()
+    raise InputError(
+        field,
+        f"too dense: placed only {placed - m} of {n} disks of radius {r_max:g} m in a "
+        f"{width:g} x {height:g} box after {max_batches} tries; use fewer or smaller disks or a "
+        "larger box",
+    )
+
+
+def _radii(value: float | ArrayLike, n: int, field: str) -> FloatArray:
+    """A fresh (n,) float64 array of radii, checked >= 0 and finite."""
+    array = np.array(value, dtype=np.float64)
+    array = np.full(n, float(array)) if array.ndim == 0 else array.reshape(-1)
+    if array.shape != (n,):
+        raise InputError(field, f"expected a scalar or {n} values, got {array.size}")
+    if not np.isfinite(array).all() or (array < 0).any():
+        raise InputError(field, "radii must be finite numbers >= 0")
+    return array
+
+
+def _check_density(
+    n: int, radii: FloatArray, old_radii: FloatArray, width: float, height: float, field: str
+) -> None:
+    """Refuse at once a covered area beyond the densest possible packing."""
+    covered = math.pi * float(np.sum(radii**2) + np.sum(old_radii**2))
+    if covered > HEXAGONAL_PACKING * width * height:
+        raise InputError(
+            field,
+            f"too dense: {n} disks cover {covered:g} m^2, more than the "
+            f"{HEXAGONAL_PACKING * width * height:g} m^2 that fit in a {width:g} x {height:g} box",
+        )
+
+
+def _cell_lists(
+    position: FloatArray, lo: FloatArray, cell: float, ncx: int, ncy: int, capacity: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Linked cell lists ``head`` (ncx*ncy,) and ``next_`` (capacity,) holding ``position``."""
+    head = np.full(ncx * ncy, -1, dtype=np.int64)
+    next_ = np.full(capacity, -1, dtype=np.int64)
+    m = position.shape[0]
+    if m == 0:
+        return head, next_
+    cx = np.clip(np.floor((position[:, 0] - lo[0]) / cell).astype(np.int64), 0, ncx - 1)
+    cy = np.clip(np.floor((position[:, 1] - lo[1]) / cell).astype(np.int64), 0, ncy - 1)
+    cells = cx + ncx * cy
+    order = np.argsort(cells, kind="stable")
+    sorted_cells = cells[order]
+    same = sorted_cells[1:] == sorted_cells[:-1]
+    next_[order[:-1][same]] = order[1:][same]
+    first = np.concatenate([[True], ~same])
+    head[sorted_cells[first]] = order[first]
+    return head, next_
+
+
+def uniform_velocities(n: int, speed: float, rng: np.random.Generator) -> FloatArray:
+    """Velocities with each component uniform in ``[-speed, speed]``.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    speed : float
+        Largest component in m/s (>= 0).
+    rng : numpy.random.Generator
+        Source of the draws.
+
+    Returns
+    -------
+    ndarray, shape (n, 2)
+        Velocities in m/s.
+    """
+    if not math.isfinite(speed) or speed < 0:
+        raise InputError("particles.speed", f"must be a finite number >= 0, got {speed!r}")
+    return rng.uniform(-speed, speed, size=(n, 2))
+
+
+def balanced_charges(n: int, charge: float, rng: np.random.Generator) -> FloatArray:
+    """Charges ``+charge`` and ``-charge`` in equal numbers, in random order.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles; ``n // 2`` get ``-charge``, the rest (one more when n is odd)
+        ``+charge``.
+    charge : float
+        Magnitude in C.
+    rng : numpy.random.Generator
+        Source of the permutation.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Charges in C.
+    """
+    negative = n // 2
+    values = np.concatenate(
+        [np.full(n - negative, float(charge)), np.full(negative, -float(charge))]
+    )
+    return rng.permutation(values)
+
+
+def rhombus_rack(
+    apex: tuple[float, float],
+    rows: int,
+    radius: float,
+    gap: float = 0.01,
+    back_tip: bool = False,
+) -> FloatArray:
+    """Centres of a pool-break rack: a rhombus of disks in hexagonal packing, apex pointing left.
+
+    Columns from the apex rightwards hold 1, 2, ..., ``rows``, ..., 2 (and 1 with ``back_tip``)
+    disks, centred on the apex's y; ``rows**2 - 1`` disks (``rows**2`` with the back tip).
+
+    Parameters
+    ----------
+    apex : (float, float)
+        Centre of the leftmost disk in m.
+    rows : int
+        Disks in the widest column (>= 1).
+    radius : float
+        Disk radius r in m (> 0).
+    gap : float
+        Surface gap between neighbours as a fraction of r: neighbouring centres are
+        ``r * (2 + gap)`` apart.
+    back_tip : bool
+        Keep the last single-disk column (the tip opposite the apex).
+
+    Returns
+    -------
+    ndarray, shape (rows**2 - 1, 2) or (rows**2, 2)
+        Centres in m, column by column from the apex, bottom to top within a column.
+    """
+    spacing = radius * (2.0 + gap)
+    columns = 2 * rows - 1 if back_tip else 2 * rows - 2
+    rows_per_column = [j + 1 if j < rows else 2 * rows - 1 - j for j in range(columns)]
+    step_x = spacing * math.sqrt(3.0) / 2.0
+    centres = [
+        (apex[0] + j * step_x, apex[1] + (k - 0.5 * (count - 1)) * spacing)
+        for j, count in enumerate(rows_per_column)
+        for k in range(count)
+    ]
+    return np.array(centres, dtype=np.float64).reshape(-1, 2)

@@ -1,0 +1,720 @@
+"""Scenario: the pydantic schema of a simulation set-up, read from and written to TOML.
+
+A scenario file::
+
+    name = "gas"
+    description = "200 neutral disks"
+    seed = 1                      # seeds every random generator in the file
+
+    [box]
+    width = 20.0                  # m
+    height = 20.0                 # m
+    boundary = "reflecting"       # or "periodic"
+
+    [run]
+    dt = 0.01                     # s
+    time = 10.0                   # s, default duration of `collidium run`
+    collisions = "exact"          # "exact" | "step" | "off"
+
+    [[forces]]
+    type = "coulomb"
+    k = 5.0                       # N m^2 / C^2
+    softening = 0.0               # m
+
+    [[particles]]                 # groups, concatenated in order
+    kind = "random"               # "explicit" | "random" | "rack"
+    n = 200
+    speed = 10.0                  # velocity components uniform in [-speed, speed], m/s
+
+`Scenario.build` turns it into a `Simulation`; the random groups draw, in group order, from one
+``numpy.random.default_rng(seed)``, so a scenario always builds the same state bit for bit. Every
+validation problem becomes one `InputError` ``field.path: reason``.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+import tomli_w
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PlainValidator,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+)
+
+from collidium.containers import Box
+from collidium.errors import InputError
+from collidium.forces import Coulomb
+from collidium.initial import balanced_charges, random_positions, rhombus_rack, uniform_velocities
+from collidium.simulation import Simulation
+from collidium.state import FloatArray, Particles
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Vector = Annotated[list[Finite], Field(min_length=2, max_length=2)]
+
+#: Largest particle count of one random group (keeps a typo from exhausting memory).
+MAX_GROUP_SIZE = 100_000_000
+
+
+def _number(value: object, what: str) -> float:
+    """A finite float from an int or float (bools and strings refused)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ValueError(f"{what} must be a number, got {value!r}")
+    number = float(value)
+    if not math.isfinite(number):
+        raise ValueError(f"{what} must be a finite number, got {value!r}")
+    return number
+
+
+def _per_particle(lower: float | None, strict: bool) -> Callable[[object], float | list[float]]:
+    """Validator of a scalar or list of numbers, each finite and above ``lower`` (when given)."""
+    sign = ">" if strict else ">="
+
+    def check(number: float, what: str) -> float:
+        if lower is not None and (number <= lower if strict else number < lower):
+            raise ValueError(f"{what} must be {sign} {lower:g}, got {number!r}")
+        return number
+
+    def validate(value: object) -> float | list[float]:
+        if isinstance(value, list | tuple):
+            return [check(_number(v, f"element {i}"), f"element {i}") for i, v in enumerate(value)]
+        return check(_number(value, "value"), "value")
+
+    return validate
+
+
+PositivePerParticle = Annotated[float | list[float], PlainValidator(_per_particle(0.0, True))]
+NonNegativePerParticle = Annotated[float | list[float], PlainValidator(_per_particle(0.0, False))]
+FinitePerParticle = Annotated[float | list[float], PlainValidator(_per_particle(None, False))]
+
+
+class _Model(BaseModel):
+    """Base of every schema model: unknown fields are errors, no silent type coercion."""
+
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+
+class BoxSpec(_Model):
+    """The vessel: a rectangle centred on the origin, sides in m."""
+
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    width: Positive = 20.0
+    height: Positive = 20.0
+    boundary: Literal["reflecting", "periodic"] = "reflecting"
+
+    def build(self) -> Box:
+        """The `Box` this describes."""
+        return Box(self.width, self.height, boundary=self.boundary)
+
+
+class RunSpec(_Model):
+    """Time step (s), default duration (s) and collision mode."""
+
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    dt: Positive = 0.01
+    time: NonNegative = 10.0
+    collisions: Literal["exact", "step", "off"] = "exact"
+
+
+class CoulombSpec(_Model):
+    """Coulomb force (seed eq. 9-10): constant k, softening length, optional acceleration cap."""
+
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    type: Literal["coulomb"] = "coulomb"
+    k: Finite = 5.0
+    softening: NonNegative = 0.0
+    max_acceleration: Positive | None = None
+
+    def build(self) -> Coulomb:
+        """The `Coulomb` force this describes."""
+        return Coulomb(k=self.k, softening=self.softening, max_acceleration=self.max_acceleration)
+
+
+ForceSpec = Annotated[CoulombSpec, Field(discriminator="type")]
+
+
+@dataclass
+class GroupState:
+    """Arrays of one particle group: position, velocity (N, 2); mass, radius, charge (N,)."""
+
+    position: FloatArray
+    velocity: FloatArray
+    mass: FloatArray
+    radius: FloatArray
+    charge: FloatArray
+
+
+def _empty() -> GroupState:
+    """A group of no particles."""
+    return GroupState(np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0))
+
+
+class ExplicitGroup(_Model):
+    """Particles listed one by one; mass, radius and charge are one value or one per particle."""
+
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    kind: Literal["explicit"] = "explicit"
+    position: Annotated[list[Vector], Field(min_length=1)]
+    velocity: list[Vector] | None = None
+    mass: PositivePerParticle = 1.0
+    radius: NonNegativePerParticle = 0.25
+    charge: FinitePerParticle = 0.0
+
+    @field_validator("velocity", "mass", "radius", "charge")
+    @classmethod
+    def _same_length(cls, value: Any, info: ValidationInfo) -> Any:
+        position = info.data.get("position")
+        if isinstance(value, list) and position is not None and len(value) != len(position):
+            raise ValueError(f"has {len(value)} entries but position has {len(position)}")
+        return value
+
+    def generate(
+        self, rng: np.random.Generator, box: Box, existing: GroupState, index: int
+    ) -> GroupState:
+        """The listed particles (no random draws)."""
+        n = len(self.position)
+        velocity = np.zeros((n, 2)) if self.velocity is None else np.array(self.velocity, float)
+        return GroupState(
+            np.array(self.position, dtype=np.float64),
+            velocity,
+            np.broadcast_to(np.asarray(self.mass, dtype=np.float64), (n,)).copy(),
+            np.broadcast_to(np.asarray(self.radius, dtype=np.float64), (n,)).copy(),
+            np.broadcast_to(np.asarray(self.charge, dtype=np.float64), (n,)).copy(),
+        )
+
+
+class RandomGroup(_Model):
+    """``n`` equal disks at uniform random non-overlapping positions with uniform random velocity
+    components in ``[-speed, speed]``; charge ``charge`` each, or ``+charge`` / ``-charge`` in
+    equal numbers in random order with ``charges = "balanced"``."""
+
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    kind: Literal["random"] = "random"
+    n: Annotated[int, Field(ge=0, le=MAX_GROUP_SIZE)]
+    mass: Positive = 1.0
+    radius: NonNegative = 0.25
+    speed: NonNegative = 0.0
+    charge: Finite = 0.0
+    charges: Literal["same", "balanced"] = "same"
+
+    def generate(
+        self, rng: np.random.Generator, box: Box, existing: GroupState, index: int
+    ) -> GroupState:
+        """Draw positions (clear of the ``existing`` disks), then velocities, then (balanced)
+        charges from ``rng``; ``index`` is the group's place in the list, named in errors."""
+        position = random_positions(
+            self.n, self.radius, box.width, box.height, rng,
+            existing=box.wrap(existing.position), existing_radius=existing.radius,
+            field=f"particles.{index}.n",
+        )  # fmt: skip
+        velocity = uniform_velocities(self.n, self.speed, rng)
+        if self.charges == "balanced":
+            charge = balanced_charges(self.n, self.charge, rng)
+        else:
+            charge = np.full(self.n, self.charge)
+        full = np.full(self.n, 1.0)
+        return GroupState(position, velocity, self.mass * full, self.radius * full, charge)
+
+
+class RackGroup(_Model):
+    """The pool-break rack: a rhombus of disks at rest in hexagonal packing, apex pointing left;
+    columns of 1, 2, ..., ``rows``, ..., 2 disks (and a last single one with ``back_tip``)."""
+
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    kind: Literal["rack"] = "rack"
+    apex: Vector = Field(default_factory=lambda: [0.0, 0.0])
+    rows: Annotated[int, Field(ge=1, le=10_000)] = 15
+    radius: Positive = 0.25
+    mass: Positive = 1.0
+    gap: NonNegative = 0.01
+    charge: Finite = 0.0
+    back_tip: bool = False
+
+    def generate(
+        self, rng: np.random.Generator, box: Box, existing: GroupState, index: int
+    ) -> GroupState:
+        """The rack's centres (no random draws); all at rest."""
+        position = rhombus_rack((self.apex[0], self.apex[1]), self.rows, self.radius, self.gap,
+                                self.back_tip)  # fmt: skip
+        full = np.full(position.shape[0], 1.0)
+        return GroupState(
+            position, np.zeros_like(position), self.mass * full, self.radius * full,
+            self.charge * full,
+        )  # fmt: skip
+
+
+Group = Annotated[ExplicitGroup | RandomGroup | RackGroup, Field(discriminator="kind")]
+
+#: Model of each table, by the discriminator value that selects it (for error messages).
+_TAGGED: dict[str, type[_Model]] = {
+    "explicit": ExplicitGroup,
+    "random": RandomGroup,
+    "rack": RackGroup,
+    "coulomb": CoulombSpec,
+}
+
+
+class Scenario(_Model):
+    """A complete simulation set-up: vessel, run settings, forces and particle groups.
+
+    Attributes
+    ----------
+    name, description : str
+        Label and one-line description.
+    seed : int
+        Seed of every random draw (group order) and of the simulation's generator.
+    box : BoxSpec
+        The vessel.
+    run : RunSpec
+        dt, default duration and collision mode.
+    forces : list of CoulombSpec
+        Forces between particles.
+    particles : list of ExplicitGroup, RandomGroup or RackGroup
+        Particle groups, concatenated in order.
+    """
+
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    name: str = "scenario"
+    description: str = ""
+    seed: Annotated[int, Field(ge=0, le=2**63 - 1)] = 0
+    box: BoxSpec = Field(default_factory=BoxSpec)
+    run: RunSpec = Field(default_factory=RunSpec)
+    forces: list[ForceSpec] = Field(default_factory=list)
+    particles: Annotated[list[Group], Field(min_length=1)]
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Scenario:
+        """Validate a plain mapping (as read from TOML; numpy values and tuples accepted).
+
+        Raises
+        ------
+        InputError
+            Naming the first offending field, e.g. ``particles.0.mass: must be > 0, got -1.0``.
+        """
+        if not isinstance(data, Mapping):
+            raise InputError("scenario", f"expected a table of fields, got {type(data).__name__}")
+        try:
+            return cls.model_validate(plain(data))
+        except ValidationError as exc:
+            field, reason = field_and_reason(exc)
+            raise InputError(field, reason) from exc
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Scenario:
+        """Read and validate a scenario file.
+
+        Raises
+        ------
+        InputError
+            For a missing or unreadable file, bad TOML syntax (file and line named) or a schema
+            violation (field named).
+        """
+        return cls.from_dict(read_toml(path))
+
+    @classmethod
+    def from_toml_string(cls, text: str, source: str = "<string>") -> Scenario:
+        """Parse and validate scenario TOML text (``source`` names it in errors)."""
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise InputError(source, f"invalid TOML: {exc}") from None
+        return cls.from_dict(data)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data (Python floats, ints, str, lists, dicts); unset optional values left out."""
+        return self.model_dump(mode="python", exclude_none=True)
+
+    def to_toml(self) -> str:
+        """The scenario as TOML text; reading it back gives an equal scenario (floats bitwise)."""
+        header = "# collidium scenario; edit it and run it with: collidium run FILE.toml\n"
+        return header + dump_toml(self.to_dict())
+
+    def with_overrides(self, overrides: Mapping[str, Any]) -> Scenario:
+        """A copy with dotted-path overrides applied, validated again (see `apply_overrides`)."""
+        return Scenario.from_dict(apply_overrides(self.to_dict(), overrides))
+
+    def initial_state(self) -> tuple[Box, Particles, list[int]]:
+        """Generate the vessel and the particles.
+
+        Returns
+        -------
+        box : Box
+        particles : Particles
+            All groups concatenated in order.
+        offsets : list of int
+            Index of the first particle of each group, then the total N (length groups + 1).
+        """
+        box = self.box.build()
+        rng = np.random.default_rng(self.seed)
+        fixed = {
+            index: group.generate(rng, box, _empty(), index)
+            for index, group in enumerate(self.particles)
+            if not isinstance(group, RandomGroup)
+        }
+        groups: list[GroupState] = []
+        for index, group in enumerate(self.particles):
+            if index in fixed:
+                groups.append(fixed[index])
+                continue
+            drawn = [state for k, state in enumerate(groups) if k not in fixed]
+            groups.append(group.generate(rng, box, _concatenate([*fixed.values(), *drawn]), index))
+        state = _concatenate(groups)
+        offsets = [0, *np.cumsum([len(g.mass) for g in groups]).tolist()]
+        particles = Particles(
+            position=state.position, velocity=state.velocity, mass=state.mass,
+            radius=state.radius, charge=state.charge,
+        )  # fmt: skip
+        return box, particles, offsets
+
+    def build(self) -> Simulation:
+        """The `Simulation` this scenario describes (bitwise the same on every call).
+
+        Raises
+        ------
+        InputError
+            For a particle outside the vessel or overlapping another (both named by their group
+            and index), a random group too dense to place, or anything `Simulation` refuses.
+        """
+        box, particles, offsets = self.initial_state()
+        _check_placement(box, particles, offsets, self, self.run.collisions)
+        try:
+            return Simulation(
+                box, particles, forces=[force.build() for force in self.forces], dt=self.run.dt,
+                collisions=self.run.collisions, seed=self.seed, name=self.name,
+            )  # fmt: skip
+        except InputError as exc:
+            raise InputError(_SIMULATION_FIELDS.get(exc.field, exc.field), exc.reason) from exc
+
+
+#: Where the fields named by `Simulation` and `Particles` live in a scenario.
+_SIMULATION_FIELDS = {
+    "position": "particles.position",
+    "velocity": "particles.velocity",
+    "mass": "particles.mass",
+    "radius": "particles.radius",
+    "charge": "particles.charge",
+    "dt": "run.dt",
+    "collisions": "run.collisions",
+}
+
+
+def _concatenate(states: list[GroupState]) -> GroupState:
+    """The groups' arrays joined in order (empty arrays for no groups)."""
+    if not states:
+        return _empty()
+    return GroupState(
+        *(np.concatenate(arrays) for arrays in zip(*(_arrays(s) for s in states), strict=True))
+    )
+
+
+def _arrays(state: GroupState) -> tuple[FloatArray, ...]:
+    return (state.position, state.velocity, state.mass, state.radius, state.charge)
+
+
+def _particle_name(index: int, offsets: list[int], scenario: Scenario) -> tuple[str, str]:
+    """Field and label of a particle: ``particles.G.position.K`` for a listed one;
+    ``particles.G`` and ``particles.G disk K`` for a generated one."""
+    group = int(np.searchsorted(offsets, index, side="right")) - 1
+    k = index - offsets[group]
+    if isinstance(scenario.particles[group], ExplicitGroup):
+        path = f"particles.{group}.position.{k}"
+        return path, path
+    return f"particles.{group}", f"particles.{group} disk {k}"
+
+
+def _local(field: str, label: str) -> str:
+    """``"disk K "`` for a generated particle (its group is the field), else nothing."""
+    return label.removeprefix(field).strip() + " " if label != field else ""
+
+
+def _check_placement(
+    box: Box, particles: Particles, offsets: list[int], scenario: Scenario, collisions: str
+) -> None:
+    """Refuse particles outside the vessel, and overlaps (unless collisions are off)."""
+    from collidium.kernels.cells import first_overlap, grid_shape
+
+    position = box.wrap(particles.position)
+    radius = particles.radius
+    outside = box.outside(position, radius)
+    if outside.size:
+        i = int(outside[0])
+        field, label = _particle_name(i, offsets, scenario)
+        x, y = particles.position[i]
+        raise InputError(
+            field,
+            f"{_local(field, label)}at ({x:g}, {y:g}) with radius "
+            f"{radius[i]:g} is outside the {box.width:g} x {box.height:g} box (centred on 0, 0)",
+        )
+    if collisions == "off" or particles.n < 2:
+        return
+    diameter = 2.0 * float(radius.max(initial=0.0))
+    ncx, ncy = grid_shape(box.width, box.height, diameter, particles.n)
+    i, j = first_overlap(position, radius, box.width, box.height, box.periodic, ncx, ncy)
+    if i >= 0:
+        field, label = _particle_name(j, offsets, scenario)
+        distance = math.dist(position[i], position[j])
+        raise InputError(
+            field,
+            f"{_local(field, label)}overlaps "
+            f"{_particle_name(i, offsets, scenario)[1]} (centres {distance:g} m apart, radii "
+            f"{radius[i]:g} + {radius[j]:g})",
+        )
+
+
+# --- plain data, TOML ---------------------------------------------------------------------------
+
+
+def plain(value: Any) -> Any:
+    """Deep copy of ``value`` with numpy scalars and arrays and tuples made plain Python."""
+    if isinstance(value, Mapping):
+        return {key: plain(item) for key, item in value.items()}
+    if isinstance(value, np.ndarray):
+        return plain(value.tolist())
+    if isinstance(value, list | tuple):
+        return [plain(item) for item in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return copy.copy(value)
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """Parse a TOML file.
+
+    Raises
+    ------
+    InputError
+        Naming the file, for a missing or unreadable file or bad syntax (with line and column).
+    """
+    name = str(path)
+    try:
+        text = Path(path).read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise InputError(name, "no such file") from None
+    except UnicodeDecodeError as exc:
+        raise InputError(name, f"not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    except OSError as exc:
+        raise InputError(name, f"cannot read: {exc.strerror or exc}") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(name, f"invalid TOML: {exc}") from None
+
+
+def _toml_scalar(value: Any) -> str:
+    return tomli_w.dumps({"v": value})[len("v = ") : -1]
+
+
+def _toml_value(value: Any, indent: str = "    ") -> str:
+    """TOML for a value: arrays of scalars on one line, arrays of arrays one row per line."""
+    if not isinstance(value, list):
+        return _toml_scalar(value)
+    if any(isinstance(item, list) for item in value):
+        rows = "".join(f"{indent}{_toml_value(item)},\n" for item in value)
+        return f"[\n{rows}]"
+    return "[" + ", ".join(_toml_scalar(item) for item in value) + "]"
+
+
+def _toml_table(table: Mapping[str, Any]) -> str:
+    return "".join(f"{key} = {_toml_value(value)}\n" for key, value in table.items())
+
+
+def dump_toml(data: Mapping[str, Any]) -> str:
+    """TOML text for scenario data: top-level values, then tables, then arrays of tables.
+
+    Parameters
+    ----------
+    data : mapping
+        Values are str, bool, int, float, lists of those or of lists, one level of tables and
+        lists of tables (the shape of `Scenario.to_dict`).
+    """
+    scalars = {k: v for k, v in data.items() if not isinstance(v, Mapping) and not _is_tables(v)}
+    chunks = [_toml_table(scalars)]
+    for key, value in data.items():
+        if isinstance(value, Mapping):
+            chunks.append(f"\n[{key}]\n{_toml_table(value)}")
+        elif _is_tables(value):
+            chunks.extend(f"\n[[{key}]]\n{_toml_table(item)}" for item in value)
+    return "".join(chunks)
+
+
+def _is_tables(value: Any) -> bool:
+    return isinstance(value, list) and bool(value) and all(isinstance(v, Mapping) for v in value)
+
+
+# --- overrides ----------------------------------------------------------------------------------
+
+
+def apply_overrides(data: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, Any]:
+    """Set values at dotted paths (``"run.dt"``, ``"particles.0.n"``), then validate the result.
+
+    Parameters
+    ----------
+    data : mapping
+        Scenario data, e.g. from `Scenario.to_dict` or a TOML file (not modified).
+    overrides : mapping of str to value
+        Dotted path -> new value. List entries are addressed by index; a missing table on the way
+        (``box`` in ``box.width``) is created.
+
+    Returns
+    -------
+    dict
+        The updated scenario data, validated by the schema (as `Scenario.to_dict` gives it).
+
+    Raises
+    ------
+    InputError
+        For a path that leads nowhere (the path named) or a value the schema refuses (the field
+        named).
+    """
+    result = plain(data)
+    for key, value in overrides.items():
+        _set_path(result, key, plain(value))
+    return Scenario.from_dict(result).to_dict()
+
+
+def _set_path(data: dict[str, Any], key: str, value: Any) -> None:
+    parts = key.split(".")
+    if not all(parts):
+        raise InputError(key, "not a field path (expected names and indices joined by dots)")
+    node: Any = data
+    for depth, part in enumerate(parts):
+        here = ".".join(parts[: depth + 1])
+        last = depth == len(parts) - 1
+        if isinstance(node, list):
+            if not part.isdigit():
+                raise InputError(here, f"expected a list index 0..{len(node) - 1}")
+            index = int(part)
+            if index >= len(node):
+                raise InputError(here, f"no entry {index}; there are {len(node)}")
+            if last:
+                node[index] = value
+            else:
+                node = node[index]
+        elif isinstance(node, dict):
+            if last:
+                node[part] = value
+            else:
+                node = node.setdefault(part, {})
+        else:
+            raise InputError(here, f"{'.'.join(parts[:depth])} is a value, not a table or list")
+
+
+# --- validation errors as one line --------------------------------------------------------------
+
+
+def field_and_reason(exc: ValidationError) -> tuple[str, str]:
+    """The first problem of a pydantic validation error as ``(dotted field path, reason)``.
+
+    The discriminator values that pydantic inserts in locations (``particles.0.random.n``) are
+    dropped: ``("particles.0.n", "must be >= 0, got -3")``.
+    """
+    errors = exc.errors(include_url=False)
+    if not errors:
+        return "scenario", str(exc)
+    error = errors[0]
+    field, reason = _reason(error)
+    if len(errors) > 1:
+        reason += f" (and {len(errors) - 1} more problem{'s' if len(errors) > 2 else ''})"
+    return field, reason
+
+
+def describe(exc: ValidationError) -> str:
+    """One line ``field.path: reason`` for a pydantic validation error."""
+    field, reason = field_and_reason(exc)
+    return f"{field}: {reason}"
+
+
+def _clean_loc(loc: tuple[int | str, ...]) -> list[int | str]:
+    out: list[int | str] = []
+    for k, part in enumerate(loc):
+        if k > 0 and isinstance(loc[k - 1], int) and part in _TAGGED:
+            continue
+        out.append(part)
+    return out
+
+
+def _reason(error: Any) -> tuple[str, str]:
+    kind = error["type"]
+    loc = _clean_loc(error["loc"])
+    ctx = error.get("ctx") or {}
+    got = _short(error.get("input"))
+    path = ".".join(str(part) for part in loc) or "scenario"
+    if kind == "extra_forbidden":
+        allowed = _allowed_fields(error["loc"][:-1])
+        hint = f"; allowed: {', '.join(allowed)}" if allowed else ""
+        return path, f"unknown field{hint}"
+    if kind == "missing":
+        return path, "required field is missing"
+    if kind in ("union_tag_not_found", "union_tag_invalid"):
+        tag = str(ctx.get("discriminator", "kind")).strip("'")
+        expected = [name for name, model in _TAGGED.items() if tag in model.model_fields]
+        what = "missing" if kind == "union_tag_not_found" else f"unknown value {ctx.get('tag')!r}"
+        return f"{path}.{tag}", f"{what}; choose from {', '.join(expected)}"
+    if kind == "greater_than":
+        return path, f"must be > {_num(ctx['gt'])}, got {got}"
+    if kind == "greater_than_equal":
+        return path, f"must be >= {_num(ctx['ge'])}, got {got}"
+    if kind == "less_than_equal":
+        return path, f"must be <= {_num(ctx['le'])}, got {got}"
+    if kind == "too_short":
+        return path, f"needs at least {ctx['min_length']} entries, got {ctx['actual_length']}"
+    if kind == "too_long":
+        return path, f"takes at most {ctx['max_length']} entries, got {ctx['actual_length']}"
+    if kind == "finite_number":
+        return path, f"must be a finite number, got {got}"
+    if kind == "value_error":
+        return path, str(ctx.get("error", error["msg"]))
+    message = error["msg"]
+    message = message[0].lower() + message[1:]
+    return path, f"{message}, got {got}" if "input" in error else message
+
+
+def _num(value: Any) -> str:
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _allowed_fields(loc: tuple[int | str, ...]) -> list[str]:
+    """Field names of the model at a raw pydantic location (empty when it cannot be told)."""
+    model: type[BaseModel] | None = Scenario
+    for k, part in enumerate(loc):
+        if isinstance(part, int):
+            model = None  # a list entry: its kind (the next part) decides the model
+        elif k > 0 and isinstance(loc[k - 1], int) and part in _TAGGED:
+            model = _TAGGED[part]
+        elif k == 0 or isinstance(loc[k - 1], str):
+            fields = model.model_fields if model is not None else {}
+            if part not in fields:
+                return []
+            model = _model_of(fields[part].annotation)
+    return list(model.model_fields) if model is not None else []
+
+
+def _model_of(annotation: Any) -> type[BaseModel] | None:
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    return None

@@ -1,0 +1,186 @@
+"""The command line, run as ``python -m collidium`` in a subprocess."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from collidium.cli import parse_settings
+from collidium.presets import presets
+
+
+def collidium(*args: str | Path, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "collidium", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=300,
+        check=False,
+    )
+
+
+def without_wall_time(summary: dict) -> dict:
+    return {key: value for key, value in summary.items() if key != "wall_seconds"}
+
+
+def test_presets_json():
+    result = collidium("presets", "--json")
+    assert result.returncode == 0, result.stderr
+    entries = json.loads(result.stdout)
+    assert [e["name"] for e in entries] == presets()
+    assert {"name", "section", "description", "parameters"} <= set(entries[0])
+
+
+def test_presets_table():
+    result = collidium("presets")
+    assert result.returncode == 0, result.stderr
+    assert "pool-break" in result.stdout and "4.1.1" in result.stdout
+
+
+def test_run_head_on_json():
+    result = collidium("run", "head-on", "--time", "1", "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert summary["scenario"] == "head-on"
+    assert summary["n"] == 2
+    assert summary["time"] == pytest.approx(1.0)
+    assert summary["steps"] == 100
+    assert summary["wall_seconds"] >= 0
+    energy = summary["energy"]
+    assert set(energy) >= {"kinetic", "potential", "total", "initial_total", "max_rel_drift"}
+    assert energy["total"] == pytest.approx(25.0, rel=1e-12)
+    assert energy["initial_total"] == pytest.approx(25.0, rel=1e-12)
+    assert energy["max_rel_drift"] < 1e-12
+    assert summary["momentum"] == pytest.approx([0.0, 0.0], abs=1e-12)
+    assert summary["collisions"]["pair"] == 1
+    assert summary["escaped"] == 0
+
+
+def test_run_table_and_steps():
+    result = collidium("run", "right-angle", "--steps", "20", "--dt", "0.005")
+    assert result.returncode == 0, result.stderr
+    assert "right-angle" in result.stdout and "escaped" in result.stdout
+
+
+def test_export_then_run_file_gives_the_same_numbers(tmp_path):
+    path = tmp_path / "gas.toml"
+    exported = collidium("export", "gas", "--set", "n=60", "--set", "seed=4", "-o", path)
+    assert exported.returncode == 0, exported.stderr
+    assert exported.stdout == ""
+    assert [p.name for p in tmp_path.iterdir()] == ["gas.toml"]  # no temporary left behind
+    from_preset = collidium("run", "gas", "--set", "n=60", "--seed", "4", "--time", "0.5", "--json")
+    from_file = collidium("run", path, "--time", "0.5", "--json")
+    assert from_preset.returncode == 0, from_preset.stderr
+    assert from_file.returncode == 0, from_file.stderr
+    a, b = json.loads(from_preset.stdout), json.loads(from_file.stdout)
+    assert without_wall_time(a) == without_wall_time(b)
+    assert a["n"] == 60 and a["collisions"]["pair"] + a["collisions"]["wall"] > 0
+
+
+def test_export_to_stdout_and_set_dotted_path():
+    result = collidium("export", "orbit", "--set", "run.collisions=step")
+    assert result.returncode == 0, result.stderr
+    assert 'name = "orbit"' in result.stdout and 'collisions = "step"' in result.stdout
+
+
+def test_run_file_with_set_and_aliases(tmp_path):
+    path = tmp_path / "h.toml"
+    assert collidium("export", "head-on", "-o", path).returncode == 0
+    result = collidium("run", path, "--set", "run.dt=0.02", "--steps", "5", "--json")
+    assert result.returncode == 0, result.stderr
+    assert json.loads(result.stdout)["dt"] == 0.02
+
+
+BAD_TOML = 'name = "x"\n[box\nwidth = 3\n'
+EXTRA = '[[particles]]\nkind = "random"\nn = 3\ncolour = "red"\n'
+NEGATIVE_MASS = '[[particles]]\nkind = "explicit"\nposition = [[0.0, 0.0]]\nmass = -1.0\n'
+OVERLAP = '[[particles]]\nkind = "explicit"\nposition = [[0.0, 0.0], [0.3, 0.0]]\n'
+OUTSIDE = '[[particles]]\nkind = "explicit"\nposition = [[0.0, 0.0], [12.0, 0.0]]\n'
+DT_ZERO = '[run]\ndt = 0.0\n[[particles]]\nkind = "random"\nn = 3\n'
+
+
+@pytest.mark.parametrize(
+    ("args", "toml", "field"),
+    [
+        (["run", "no-such-preset"], None, "preset"),
+        (["export", "no-such-preset"], None, "preset"),
+        (["run", "{file}"], BAD_TOML, "{file}"),
+        (["run", "{file}"], EXTRA, "particles.0.colour"),
+        (["run", "{file}"], NEGATIVE_MASS, "particles.0.mass"),
+        (["run", "{file}"], DT_ZERO, "run.dt"),
+        (["run", "{file}"], OVERLAP, "particles.0.position.1"),
+        (["run", "{file}"], OUTSIDE, "particles.0.position.1"),
+        (["run", "head-on", "--dt", "0"], None, "dt"),
+        (["run", "head-on", "--dt", "nan"], None, "dt"),
+        (["run", "head-on", "--set", "run.dt=nan"], None, "run.dt"),
+        (["run", "head-on", "--set", "mass=-1"], None, "mass"),
+        (["run", "head-on", "--time", "1", "--steps", "3"], None, "--time"),
+        (["run", "head-on", "--time", "abc"], None, "--time"),
+        (["run", "head-on", "--steps", "1.5"], None, "--steps"),
+        (["run", "head-on", "--set", "n=5"], None, "n"),
+        (["run", "head-on", "--set", "novalue"], None, "--set"),
+        (["run", "head-on", "--frobnicate"], None, "--frobnicate"),
+        (["run", "missing.toml"], None, "missing.toml"),
+        (["export", "gas", "-o", "no/such/dir/gas.toml"], None, "no/such/dir/gas.toml"),
+        (["dance"], None, "command"),
+    ],
+)
+def test_bad_input_gives_one_line_and_exit_2(tmp_path, args, toml, field):
+    file = tmp_path / "scenario.toml"
+    if toml is not None:
+        file.write_text(toml)
+    result = collidium(*(a.replace("{file}", str(file)) for a in args), cwd=tmp_path)
+    assert result.returncode == 2, result.stdout + result.stderr
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith(f"error: {field.replace('{file}', str(file))}: "), lines[0]
+    assert "Traceback" not in result.stderr
+    assert result.stdout == ""
+
+
+def test_bad_toml_error_names_the_line(tmp_path):
+    file = tmp_path / "broken.toml"
+    file.write_text(BAD_TOML)
+    result = collidium("run", file)
+    assert "line 2" in result.stderr
+
+
+def test_failed_export_leaves_no_file(tmp_path):
+    target = tmp_path / "out.toml"
+    result = collidium("export", "gas", "--set", "n=-1", "-o", target)
+    assert result.returncode == 2
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_parse_settings_reads_toml_values():
+    values = parse_settings(["n=500", "k=2.5", "collisions=step", "flag=true", "apex=[1, 2]"])
+    assert values == {"n": 500, "k": 2.5, "collisions": "step", "flag": True, "apex": [1, 2]}
+    assert type(values["n"]) is int and type(values["k"]) is float
+
+
+def test_failed_run_gives_one_line_and_exit_1(monkeypatch, capsys):
+    import collidium.loading
+    from collidium.cli import main
+    from collidium.errors import SimulationError
+
+    def explode(source, **overrides):
+        raise SimulationError("step 3 (t = 0.03 s): particle(s) 0, 1 a non-finite position")
+
+    monkeypatch.setattr(collidium.loading, "load_scenario", explode)
+    assert main(["run", "head-on", "--json"]) == 1
+    captured = capsys.readouterr()
+    assert (
+        captured.err == "error: run: step 3 (t = 0.03 s): particle(s) 0, 1 a non-finite position\n"
+    )
+    assert captured.out == ""
+
+
+def test_no_arguments_shows_help():
+    result = collidium()
+    assert result.returncode == 0
+    assert "run" in result.stdout and "export" in result.stdout

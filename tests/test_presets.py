@@ -1,0 +1,222 @@
+"""Presets: the exact parameters of DESIGN.md section 3, overrides, the registry."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from collidium import load
+from collidium.errors import InputError
+from collidium.loading import load_scenario
+from collidium.presets import PRESETS, describe_presets, parameters, preset, presets
+from collidium.scenario import Scenario
+
+SECTIONS = {
+    "head-on": "3.1.1",
+    "right-angle": "3.1.2",
+    "gas": "3.1.3",
+    "charged-like": "3.2.1",
+    "charged-opposite": "3.2.1",
+    "orbit": "3.2.2",
+    "bohr-atom": "3.2.2",
+    "charged-gas": "3.2.3",
+    "pool-break": "4.1.1",
+    "charged-no-collisions": "4.2.1",
+}
+
+# name -> (positions, velocities, masses, charges, radius, Coulomb (k, softening) or None)
+TWO_BODY = {
+    "head-on": ([[-1, 0], [1, 0]], [[5, 0], [-5, 0]], [1, 1], [0, 0], 0.25, None),
+    "right-angle": ([[0, 1], [1, 0]], [[0, -5], [-5, 0]], [1, 1], [0, 0], 0.25, None),
+    "charged-like": ([[-5, 0], [5, 0]], [[2, 0], [-2, 0]], [1, 1], [1, 1], 0.25, (5, 0)),
+    "charged-opposite": ([[-5, 0], [5, 0]], [[2, 0], [-2, 0]], [1, 1], [1, -1], 0.25, (5, 0)),
+    "orbit": ([[-2, 0], [2, 0]], [[0, -0.6], [0, 0.6]], [1, 1], [-1, 1], 0.25, (5, 0)),
+    "bohr-atom": (
+        [[0, 0], [3, 0], [-5, 0]],
+        [[0, 0], [0, 12.9], [0, -10]],
+        [100, 0.1, 0.1],
+        [10, -1, -1],
+        0.25,
+        (5, 0),
+    ),
+    "charged-no-collisions": (
+        [[-5, 0], [5, 0]],
+        [[2, 0], [-2, 0]],
+        [1, 1],
+        [1, -1],
+        0.0,
+        (5, 0.05),
+    ),
+}
+
+
+def test_registry_lists_every_preset_in_report_order():
+    assert presets() == list(SECTIONS)
+    assert set(PRESETS) == set(SECTIONS)
+
+
+def test_describe_presets_sections_descriptions_parameters():
+    entries = describe_presets()
+    assert [e["name"] for e in entries] == list(SECTIONS)
+    for entry in entries:
+        assert entry["section"] == SECTIONS[entry["name"]]
+        assert entry["description"] and "\n" not in entry["description"]
+        assert entry["parameters"] == parameters(entry["name"])
+        assert {"seed", "dt", "time", "collisions", "radius"} <= set(entry["parameters"])
+
+
+@pytest.mark.parametrize("name", list(SECTIONS))
+def test_default_vessel_and_run(name):
+    scenario = preset(name)
+    assert isinstance(scenario, Scenario)
+    assert scenario.name == name
+    assert scenario.run.dt == 0.01
+    assert scenario.run.collisions == "exact"
+    assert scenario.run.time == (60.0 if name == "pool-break" else 10.0)
+    assert scenario.box.boundary == "reflecting"
+    size = (40.0, 20.0) if name == "pool-break" else (20.0, 20.0)
+    assert (scenario.box.width, scenario.box.height) == size
+
+
+@pytest.mark.parametrize("name", list(TWO_BODY))
+def test_few_body_presets_exact(name):
+    position, velocity, mass, charge, radius, coulomb = TWO_BODY[name]
+    sim = preset(name).build()
+    p = sim.particles
+    np.testing.assert_array_equal(p.position, np.array(position, float))
+    np.testing.assert_array_equal(p.velocity, np.array(velocity, float))
+    np.testing.assert_array_equal(p.mass, mass)
+    np.testing.assert_array_equal(p.charge, charge)
+    assert (p.radius == radius).all()
+    if coulomb is None:
+        assert sim.forces == ()
+    else:
+        (force,) = sim.forces
+        assert (force.k, force.softening, force.max_acceleration) == (*coulomb, None)
+
+
+@pytest.mark.parametrize("name", ["gas", "charged-gas"])
+def test_gas_presets(name):
+    sim = preset(name).build()
+    p = sim.particles
+    assert p.n == 200
+    assert (p.mass == 1).all() and (p.radius == 0.25).all()
+    assert (np.abs(p.velocity) <= 10).all() and np.abs(p.velocity).max() > 9
+    assert (np.abs(p.position) <= 10 - 0.25).all()
+    distance = np.hypot(*(p.position[:, None] - p.position[None]).transpose(2, 0, 1))
+    np.fill_diagonal(distance, np.inf)
+    assert distance.min() >= 0.5
+    if name == "gas":
+        assert (p.charge == 0).all() and sim.forces == ()
+    else:
+        assert (p.charge == 1).sum() == 100 and (p.charge == -1).sum() == 100
+        assert not (p.charge[:100] == 1).all()  # random order
+        (force,) = sim.forces
+        assert (force.k, force.softening) == (5.0, 0.0)
+
+
+def test_pool_break():
+    sim = preset("pool-break").build()
+    p = sim.particles
+    assert p.n == 225
+    rack, cue = p.position[:224], p.position[224]
+    assert tuple(cue) == (-10.0, 0.0)
+    assert tuple(p.velocity[224]) == (100.0, 0.0)
+    assert (p.velocity[:224] == 0).all()
+    assert (p.mass == 1).all() and (p.radius == 0.25).all() and (p.charge == 0).all()
+    assert tuple(rack[0]) == (3.0, 0.0) and rack[:, 0].min() == 3.0
+    columns = np.unique(np.round(rack[:, 0], 9), return_counts=True)[1]
+    assert list(columns) == [*range(1, 16), *range(14, 1, -1)]
+    distance = np.hypot(*(rack[:, None] - rack[None]).transpose(2, 0, 1))
+    np.fill_diagonal(distance, np.inf)
+    assert distance.min() == pytest.approx(2 * 0.25 * 1.005, rel=1e-12)
+    # the rack lies inside the 40 x 20 table
+    assert (np.abs(rack[:, 0]) + 0.25 <= 20).all() and (np.abs(rack[:, 1]) + 0.25 <= 10).all()
+    assert sim.forces == () and sim.escaped() == 0
+
+
+def test_pool_break_rack_must_fit_the_table():
+    with pytest.raises(InputError) as info:
+        preset("pool-break", width=25.0).build()
+    assert info.value.field == "particles.0"
+    assert "outside" in info.value.reason
+
+
+def test_common_overrides():
+    scenario = preset(
+        "charged-opposite",
+        dt=0.005,
+        k=2.5,
+        radius=0.1,
+        mass=2.0,
+        time=3.0,
+        collisions="step",
+        seed=7,
+        width=30.0,
+        height=12.0,
+    )
+    assert (scenario.run.dt, scenario.run.time, scenario.run.collisions) == (0.005, 3.0, "step")
+    assert (scenario.box.width, scenario.box.height, scenario.seed) == (30.0, 12.0, 7)
+    assert scenario.forces[0].k == 2.5
+    p = scenario.build().particles
+    assert (p.radius == 0.1).all() and (p.mass == 2.0).all()
+
+
+def test_gas_overrides_and_seed():
+    a = preset("gas", n=50, speed=2.0, seed=3).build().particles
+    b = preset("gas", n=50, speed=2.0, seed=3).build().particles
+    c = preset("gas", n=50, speed=2.0, seed=4).build().particles
+    assert a.n == 50 and (np.abs(a.velocity) <= 2).all()
+    assert a.position.tobytes() == b.position.tobytes()
+    assert not np.array_equal(a.position, c.position)
+
+
+def test_pool_break_cue_speed_and_softening_overrides():
+    assert tuple(preset("pool-break", speed=40.0).build().particles.velocity[-1]) == (40.0, 0.0)
+    assert preset("charged-no-collisions", softening=0.2).forces[0].softening == 0.2
+
+
+def test_unknown_preset():
+    with pytest.raises(InputError) as info:
+        preset("gass")
+    assert info.value.field == "preset"
+    assert "unknown preset 'gass'; choose from head-on" in info.value.reason
+
+
+@pytest.mark.parametrize(("name", "key"), [("gas", "k"), ("head-on", "n"), ("bohr-atom", "mass")])
+def test_unknown_override_is_named(name, key):
+    with pytest.raises(InputError) as info:
+        preset(name, **{key: 1})
+    assert info.value.field == key
+    assert f"not a parameter of preset '{name}'; it takes: " in info.value.reason
+
+
+def test_invalid_override_value_names_the_parameter():
+    with pytest.raises(InputError, match=r"^n: must be >= 0"):
+        preset("gas", n=-5)
+    with pytest.raises(InputError, match=r"^dt: must be > 0"):
+        preset("head-on", dt=0.0)
+
+
+def test_load_preset_with_keywords_and_dotted_paths():
+    sim = load("gas", n=30, seed=2, **{"run.dt": 0.002, "box.boundary": "periodic"})
+    assert sim.particles.n == 30 and sim.dt == 0.002 and sim.container.periodic
+
+
+def test_load_file_with_aliases(tmp_path):
+    path = tmp_path / "gas.toml"
+    path.write_text(preset("gas", n=20).to_toml())
+    scenario = load_scenario(
+        str(path), dt=0.02, time=2.0, collisions="step", seed=5, **{"particles.0.n": 12}
+    )
+    assert (scenario.run.dt, scenario.run.time, scenario.run.collisions) == (0.02, 2.0, "step")
+    assert scenario.seed == 5 and scenario.to_dict()["particles"][0]["n"] == 12
+    with pytest.raises(InputError, match=r"^n: unknown field"):
+        load_scenario(path, n=3)
+
+
+def test_load_unknown_source():
+    with pytest.raises(InputError, match=r"^preset: unknown preset 'nothing'"):
+        load("nothing")
+    with pytest.raises(InputError, match="no such file"):
+        load("nothing.toml")
