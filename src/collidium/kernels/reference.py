@@ -167,3 +167,67 @@ def _next_contact(
             i, j = np.unravel_index(np.argmin(delay), delay.shape)
             best, pair = float(delay[i, j]), (int(i), int(j))
     return best, pair[0], pair[1]
+
+
+def drift_reflecting(
+    position: FloatArray, velocity: FloatArray, radius: FloatArray, half: FloatArray, dt: float
+) -> FloatArray:
+    """Twin of `walls.drift_reflecting`: straight drift, then bounce-by-bounce folding per
+    coordinate. Updates position and velocity (N, 2) in place; returns hits per wall
+    (left, right, bottom, top)."""
+    hits = np.zeros(4, dtype=np.int64)
+    for i in range(len(position)):
+        for d in range(2):
+            lo, hi = radius[i] - half[d], half[d] - radius[i]
+            x = position[i, d] + velocity[i, d] * dt
+            v = velocity[i, d]
+            while x < lo or x > hi:
+                hits[2 * d + (1 if x > hi else 0)] += 1
+                x, v = (2 * lo - x, -v) if x < lo else (2 * hi - x, -v)
+            position[i, d], velocity[i, d] = x, v
+    return hits
+
+
+def drift_periodic(
+    position: FloatArray, velocity: FloatArray, image: np.ndarray, size: FloatArray, dt: float
+) -> None:
+    """Twin of `walls.drift_periodic`: drift, wrap into ``[-L/2, L/2)``, count the images."""
+    moved = position + velocity * dt
+    shift = np.floor((moved + size / 2) / size)
+    position[...] = moved - shift * size
+    image += shift.astype(np.int64)
+
+
+def place_disks(
+    candidates: FloatArray, radius: FloatArray, position: FloatArray, placed: int
+) -> int:
+    """Twin of `placement.place_disks` without a grid: accept, in order, each candidate that
+    overlaps none of the disks placed so far. Fills ``position`` (N, 2); returns the count."""
+    for x in candidates:
+        if placed == len(position):
+            break
+        gaps = np.linalg.norm(position[:placed] - x, axis=1)
+        if np.all(gaps >= radius[:placed] + radius[placed]):
+            position[placed] = x
+            placed += 1
+    return placed
+
+
+def first_invalid(
+    position: FloatArray,
+    velocity: FloatArray,
+    radius: FloatArray,
+    half: FloatArray,
+    periodic: bool,
+    tolerance: float,
+) -> tuple[int, int]:
+    """Twin of `audit.first_invalid`: (index, 1) for a non-finite value, (index, 2) for a particle
+    outside the box, whichever index comes first; (-1, 0) if none."""
+    finite = np.isfinite(position).all(axis=1) & np.isfinite(velocity).all(axis=1)
+    reach = np.abs(position) + (0.0 if periodic else radius[:, None])
+    inside = (reach <= half * (1 + tolerance)).all(axis=1)
+    bad = np.flatnonzero(~finite | ~inside)
+    if bad.size == 0:
+        return -1, 0
+    i = int(bad[0])
+    return i, 1 if not finite[i] else 2
