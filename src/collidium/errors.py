@@ -16,11 +16,15 @@ class InputError(ValueError):
         Dotted name of the field, e.g. ``"particles.mass"`` or ``"dt"``.
     reason : str
         Why the value is refused, in a few words.
+    particles : tuple of int, optional
+        Indices of the particles at fault (an overlapping pair, a particle outside the vessel), so
+        that a front end can name them in its own terms.
     """
 
-    def __init__(self, field: str, reason: str) -> None:
+    def __init__(self, field: str, reason: str, particles: tuple[int, ...] = ()) -> None:
         self.field = field
         self.reason = reason
+        self.particles = particles
         super().__init__(f"{field}: {reason}")
 
 

@@ -57,7 +57,7 @@ from collidium.containers import Box
 from collidium.errors import InputError
 from collidium.forces import Coulomb
 from collidium.initial import balanced_charges, random_positions, rhombus_rack, uniform_velocities
-from collidium.simulation import Simulation
+from collidium.simulation import Simulation, outside_detail, overlap_detail
 from collidium.state import FloatArray, Particles
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
@@ -396,14 +396,28 @@ class Scenario(_Model):
             and index), a random group too dense to place, or anything `Simulation` refuses.
         """
         box, particles, offsets = self.initial_state()
-        _check_placement(box, particles, offsets, self, self.run.collisions)
         try:
             return Simulation(
                 box, particles, forces=[force.build() for force in self.forces], dt=self.run.dt,
                 collisions=self.run.collisions, seed=self.seed, name=self.name,
             )  # fmt: skip
         except InputError as exc:
+            if exc.particles:
+                raise self._placement_error(exc.particles, box, particles, offsets) from None
             raise InputError(_SIMULATION_FIELDS.get(exc.field, exc.field), exc.reason) from exc
+
+    def _placement_error(
+        self, culprits: tuple[int, ...], box: Box, particles: Particles, offsets: list[int]
+    ) -> InputError:
+        """A `Simulation` placement error restated with the particles named by group."""
+        last = culprits[-1]
+        field, label = _particle_name(last, offsets, self)
+        if len(culprits) == 1:
+            detail = outside_detail(box, particles, last)
+        else:
+            first = _particle_name(culprits[0], offsets, self)[1]
+            detail = f"overlaps {first} {overlap_detail(box, particles, culprits[0], last)}"
+        return InputError(field, f"{_local(field, label)}{detail}", particles=culprits)
 
 
 #: Where the fields named by `Simulation` and `Particles` live in a scenario.
@@ -445,40 +459,6 @@ def _particle_name(index: int, offsets: list[int], scenario: Scenario) -> tuple[
 def _local(field: str, label: str) -> str:
     """``"disk K "`` for a generated particle (its group is the field), else nothing."""
     return label.removeprefix(field).strip() + " " if label != field else ""
-
-
-def _check_placement(
-    box: Box, particles: Particles, offsets: list[int], scenario: Scenario, collisions: str
-) -> None:
-    """Refuse particles outside the vessel, and overlaps (unless collisions are off)."""
-    from collidium.kernels.cells import first_overlap, grid_shape
-
-    position = box.wrap(particles.position)
-    radius = particles.radius
-    outside = box.outside(position, radius)
-    if outside.size:
-        i = int(outside[0])
-        field, label = _particle_name(i, offsets, scenario)
-        x, y = particles.position[i]
-        raise InputError(
-            field,
-            f"{_local(field, label)}at ({x:g}, {y:g}) with radius "
-            f"{radius[i]:g} is outside the {box.width:g} x {box.height:g} box (centred on 0, 0)",
-        )
-    if collisions == "off" or particles.n < 2:
-        return
-    diameter = 2.0 * float(radius.max(initial=0.0))
-    ncx, ncy = grid_shape(box.width, box.height, diameter, particles.n)
-    i, j = first_overlap(position, radius, box.width, box.height, box.periodic, ncx, ncy)
-    if i >= 0:
-        field, label = _particle_name(j, offsets, scenario)
-        distance = math.dist(position[i], position[j])
-        raise InputError(
-            field,
-            f"{_local(field, label)}overlaps "
-            f"{_particle_name(i, offsets, scenario)[1]} (centres {distance:g} m apart, radii "
-            f"{radius[i]:g} + {radius[j]:g})",
-        )
 
 
 # --- plain data, TOML ---------------------------------------------------------------------------

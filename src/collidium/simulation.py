@@ -304,16 +304,28 @@ def _check_dt(dt: float) -> None:
         raise InputError("dt", f"must be a finite number > 0, got {dt!r}")
 
 
+def outside_detail(container: Box, particles: Particles, i: int) -> str:
+    """Where particle i is and why that is outside the vessel (for error messages)."""
+    x, y = particles.position[i]
+    return (
+        f"at ({x:g}, {y:g}) with radius {particles.radius[i]:g} is outside the "
+        f"{container.width:g} x {container.height:g} box (centred on 0, 0)"
+    )
+
+
+def overlap_detail(container: Box, particles: Particles, i: int, j: int) -> str:
+    """How far apart two overlapping disks are (for error messages)."""
+    gap = np.linalg.norm(container.minimum_image(particles.position[j] - particles.position[i]))
+    radius = particles.radius
+    return f"(centres {gap:g} m apart, radii {radius[i]:g} + {radius[j]:g})"
+
+
 def _check_placement(container: Box, particles: Particles, collisions: str) -> None:
     outside = container.outside(particles.position, particles.radius)
     if outside.size:
         i = int(outside[0])
-        x, y = particles.position[i]
-        raise InputError(
-            "position",
-            f"particle {i} at ({x:g}, {y:g}) with radius {particles.radius[i]:g} is outside "
-            f"the {container.width:g} x {container.height:g} box",
-        )
+        detail = outside_detail(container, particles, i)
+        raise InputError("position", f"particle {i} {detail}", particles=(i,))
     if collisions == "off":
         return  # pass-through disks may overlap
     ncx, ncy = grid_shape(
@@ -325,4 +337,5 @@ def _check_placement(container: Box, particles: Particles, collisions: str) -> N
         container.periodic, ncx, ncy,
     )  # fmt: skip
     if i >= 0:
-        raise InputError("position", f"particles {i} and {j} overlap")
+        detail = overlap_detail(container, particles, i, j)
+        raise InputError("position", f"particles {i} and {j} overlap {detail}", particles=(i, j))

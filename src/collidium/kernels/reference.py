@@ -171,7 +171,7 @@ def _next_contact(
 
 def drift_reflecting(
     position: FloatArray, velocity: FloatArray, radius: FloatArray, half: FloatArray, dt: float
-) -> FloatArray:
+) -> np.ndarray:
     """Twin of `walls.drift_reflecting`: straight drift, then bounce-by-bounce folding per
     coordinate. Updates position and velocity (N, 2) in place; returns hits per wall
     (left, right, bottom, top)."""
@@ -223,7 +223,7 @@ def first_invalid(
 ) -> tuple[int, int]:
     """Twin of `audit.first_invalid`: (index, 1) for a non-finite value, (index, 2) for a particle
     outside the box, whichever index comes first; (-1, 0) if none."""
-    finite = np.isfinite(position).all(axis=1) & np.isfinite(velocity).all(axis=1)
+    finite = np.asarray(np.isfinite(position).all(axis=1) & np.isfinite(velocity).all(axis=1))
     reach = np.abs(position) + (0.0 if periodic else radius[:, None])
     inside = (reach <= half * (1 + tolerance)).all(axis=1)
     bad = np.flatnonzero(~finite | ~inside)
