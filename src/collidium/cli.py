@@ -178,29 +178,12 @@ def run_summary(sim: Any, drift: Any, wall_seconds: float) -> dict[str, Any]:
     wall_seconds : float
         Elapsed real time of the run in s.
     """
-    energy = sim.energy()
-    counters = sim.counters
-    return {
-        "scenario": sim.name,
-        "n": int(sim.particles.n),
-        "time": float(sim.time),
-        "steps": int(sim.steps),
-        "dt": float(sim.dt),
-        "wall_seconds": wall_seconds,
-        "energy": {
-            "kinetic": float(energy.kinetic),
-            "potential": float(energy.potential),
-            "total": float(energy.total),
-            "initial_total": _finite_or_none(drift.initial_total),
-            "max_rel_drift": _finite_or_none(drift.max_rel_drift),
-        },
-        "momentum": [float(x) for x in sim.momentum()],
-        "collisions": {
-            "pair": int(counters.pair_collisions),
-            "wall": int(counters.wall_collisions),
-        },
-        "escaped": int(sim.escaped()),
-    }
+    summary: dict[str, Any] = sim.summary()
+    summary["dt"] = float(sim.dt)
+    summary["wall_seconds"] = wall_seconds
+    summary["energy"]["initial_total"] = _finite_or_none(drift.initial_total)
+    summary["energy"]["max_rel_drift"] = _finite_or_none(drift.max_rel_drift)
+    return summary
 
 
 def _finite_or_none(value: float) -> float | None:
