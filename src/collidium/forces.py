@@ -115,9 +115,9 @@ class ForceField:
         potential = 0.0
         for force in self.forces:
             force.compute(particles, box, self._force, self._energy)
-            contribution = self._force / particles.mass[:, None]
-            force.limit(contribution)
-            self._acceleration += contribution
+            np.divide(self._force, particles.mass[:, None], out=self._force)  # now an acceleration
+            force.limit(self._force)
+            self._acceleration += self._force
             potential += float(np.sum(self._energy))
         self._potential = potential
         self._evaluated_at = particles.position.copy()
