@@ -63,21 +63,3 @@ def test_bad_simulation_settings_name_the_field(kwargs, field):
     with pytest.raises(InputError) as info:
         Simulation(Box(20, 20), Particles(position=[[0.0, 0.0]]), **kwargs)
     assert info.value.field == field
-
-
-@pytest.mark.parametrize(
-    ("args", "field"),
-    [((0, 10), "box.width"), ((10, -1), "box.height"), ((10, 10, "sticky"), "box.boundary")],
-)
-def test_bad_box_names_the_field(args, field):
-    with pytest.raises(InputError) as info:
-        Box(*args)
-    assert info.value.field == field
-
-
-def test_periodic_positions_are_wrapped_and_images_kept():
-    p = Particles(position=[[12.0, -31.0]], radius=0.25)
-    sim = Simulation(Box(20, 20, "periodic"), p)
-    np.testing.assert_allclose(sim.particles.position, [[-8.0, 9.0]])
-    np.testing.assert_array_equal(sim.particles.image, [[1, -2]])
-    np.testing.assert_allclose(sim.unwrapped_position(), [[12.0, -31.0]])
