@@ -222,3 +222,14 @@ def test_time_and_steps_are_exclusive():
     sim = cd.load("head-on")
     with pytest.raises(cd.InputError, match="exactly one"):
         sim.run(time=1.0, steps=3)
+
+
+@pytest.mark.parametrize("mode", ["exact", "step", "off"])
+def test_points_wrap_through_a_periodic_box(mode):
+    start = np.array([[0.0, 0.0], [1.0, 1.0]])
+    velocity = np.array([[7.0, 3.0], [-2.0, 5.0]])
+    box = cd.Box(20, 20, "periodic")
+    sim = cd.Simulation(box, cd.Particles(start, velocity, radius=0.0), dt=0.1, collisions=mode)
+    sim.run(time=10.0)
+    np.testing.assert_allclose(sim.unwrapped_position(), start + 10.0 * velocity, atol=1e-12)
+    assert sim.escaped() == 0

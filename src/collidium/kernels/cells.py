@@ -1,8 +1,8 @@
 """Uniform cell grid over the box: linked lists of particles per cell, neighbour table, overlaps.
 
 Cells are at least one largest diameter wide, so two disks in contact always sit in the same or
-adjacent cells. Radius-0 particles are kept out of the grid (they never collide with each other or
-with disks).
+adjacent cells. Radius-0 particles are in the grid too (the event engine wraps particles through
+cell crossings in a periodic box) but every pair loop skips them: they never collide.
 """
 
 from __future__ import annotations
@@ -66,14 +66,14 @@ def fill_cells(
     next_: np.ndarray,
     prev: np.ndarray,
 ) -> None:
-    """Put every particle with radius > 0 in its cell's doubly linked list.
+    """Put every particle in its cell's doubly linked list.
 
     Parameters
     ----------
     position : ndarray, shape (N, 2)
         Centres in m (inside the box).
     radius : ndarray, shape (N,)
-        Radii in m; radius-0 particles get ``cell_of = -1``.
+        Radii in m (unused; kept so all cell kernels take the same arrays).
     half_width, half_height : float
         Half sides of the box in m.
     ncx, ncy : int
@@ -89,9 +89,6 @@ def fill_cells(
     for i in range(position.shape[0] - 1, -1, -1):
         next_[i] = -1
         prev[i] = -1
-        if radius[i] <= 0.0:
-            cell_of[i] = -1
-            continue
         c = cell_index(position[i, 0], half_width, cw, ncx) + ncx * cell_index(
             position[i, 1], half_height, ch, ncy
         )
@@ -129,7 +126,7 @@ def first_overlap(
     best_j = -1
     for i in range(n):
         ci = cell_of[i]
-        if ci < 0:
+        if radius[i] <= 0.0:
             continue
         for k in range(9):
             c = cells[ci, k]
@@ -137,7 +134,7 @@ def first_overlap(
                 continue
             j = head[c]
             while j >= 0:
-                if j > i:
+                if j > i and radius[j] > 0.0:
                     dx = position[j, 0] + shifts[ci, k, 0] * width - position[i, 0]
                     dy = position[j, 1] + shifts[ci, k, 1] * height - position[i, 1]
                     sigma = radius[i] + radius[j]

@@ -59,7 +59,7 @@ def overlapping_pairs(
     count = 0
     for i in range(n):
         ci = cell_of[i]
-        if ci < 0:
+        if radius[i] <= 0.0:  # points take no part in collisions
             continue
         for k in range(9):
             c = cells[ci, k]
@@ -67,7 +67,7 @@ def overlapping_pairs(
                 continue
             j = head[c]
             while j >= 0:
-                if j > i:
+                if j > i and radius[j] > 0.0:
                     dx = position[j, 0] + shifts[ci, k, 0] * width - position[i, 0]
                     dy = position[j, 1] + shifts[ci, k, 1] * height - position[i, 1]
                     sigma = radius[i] + radius[j]
