@@ -369,7 +369,10 @@ def test_export_then_load_every_preset_is_bitwise_identical(name, tmp_path):
     path = tmp_path / f"{name}.toml"
     path.write_text(scenario.to_toml())
     loaded = Scenario.from_toml(path)
-    assert state_bytes(loaded.build()) == state_bytes(scenario.build())
+    original, reloaded = scenario.build(), loaded.build()
+    assert state_bytes(reloaded) == state_bytes(original)
+    # ...and so is the run that follows.
+    assert state_bytes(reloaded.run(time=1.0)) == state_bytes(original.run(time=1.0))
 
 
 # --- overrides -----------------------------------------------------------------------------------
