@@ -108,7 +108,7 @@ class Simulation:
         self.name = name or "custom"
         self.steps = 0
         self.observers: list[Observer] = []
-        self._attached: set[int] = set()
+        self._attached: list[Observer] = []  # observers already attached (by identity)
         self._field = ForceField(tuple(forces))
         self._drift = make_drift(collisions)
         self._integrator = Leapfrog()
@@ -164,9 +164,9 @@ class Simulation:
         """
         count = _step_count(time, steps, self.dt)
         for observer in self.observers:
-            if id(observer) not in self._attached:
+            if not any(observer is seen for seen in self._attached):
                 observer.attach(self)
-                self._attached.add(id(observer))
+                self._attached.append(observer)
         if self._field.active:
             self._field.evaluate(self.particles, self.container)
         if progress:
