@@ -54,3 +54,21 @@ def test_step_mode_matches_exact_mode_for_slow_dilute_gas_over_a_short_time():
     assert exact.counters.wall_collisions == step.counters.wall_collisions
     # Each collision is resolved at most one step late: positions differ by O(v dt) per collision.
     assert np.abs(exact.particles.position - step.particles.position).max() < 0.05
+
+
+def test_exact_wall_hit_mirrors_the_normal_component():
+    box = cd.Box(20, 20)
+    sim = cd.Simulation(box, cd.Particles([[9.0, 0.0]], [[4.0, 3.0]], radius=0.5), dt=0.25)
+    sim.run(steps=1)
+    # Contact at x = 9.5 after 0.125 s, then 0.125 s back to x = 9.0; y moves on undisturbed.
+    np.testing.assert_array_equal(sim.particles.velocity, [[-4.0, 3.0]])
+    np.testing.assert_allclose(sim.particles.position, [[9.0, 0.75]], rtol=0, atol=1e-15)
+    assert sim.counters.wall_hits == {"left": 0, "right": 1, "bottom": 0, "top": 0}
+
+
+def test_engine_follows_a_radius_change_between_runs():
+    sim = cd.load("head-on")
+    sim.run(time=0.1)  # centres 1 m apart, closing at 10 m/s: contact at t = 0.15 s
+    sim.particles.radius[:] = 0.4  # contact now 0.2 m sooner
+    sim.run(time=0.03)
+    assert sim.counters.pair_collisions == 1

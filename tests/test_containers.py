@@ -28,8 +28,10 @@ def test_minimum_image():
 
 
 def test_disks_too_large_for_the_box_are_refused():
-    with pytest.raises(InputError, match="does not fit"):
+    with pytest.raises(InputError, match="smaller than the box side"):
         Box(1, 1).check_fits(np.array([0.6]))
+    with pytest.raises(InputError, match="smaller than the box side"):
+        Box(20, 0.5).check_fits(np.array([0.25]))  # would bounce between walls at no cost
     with pytest.raises(InputError, match="periodic"):
         Box(4, 4, "periodic").check_fits(np.array([1.1]))
 

@@ -423,3 +423,15 @@ def test_numpy_values_are_accepted():
     scenario = Scenario.from_dict(data)
     assert scenario.seed == 3 and type(scenario.seed) is int
     assert scenario.to_dict()["particles"][0]["position"] == [[0.0, 0.0]]
+
+
+def test_random_disks_clear_the_periodic_images_of_listed_ones():
+    data = {
+        "box": {"boundary": "periodic"},
+        "particles": [
+            {"kind": "explicit", "position": [[9.95, 0.0]]},
+            {"kind": "random", "n": 600},
+        ],
+    }
+    sim = Scenario.from_dict(data).build()  # overlaps across the edge would be refused here
+    assert sim.particles.n == 601

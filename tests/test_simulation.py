@@ -58,9 +58,9 @@ def test_head_on_preset_swaps_velocities():
 
 def test_right_angle_preset_leaves_left_and_down():
     sim = cd.load("right-angle").run(time=0.5)
-    (vx0, _vy0), (_vx1, vy1) = sim.particles.velocity
-    # The top particle leaves to the left, the right one downwards (seed 3.1.2).
-    assert vx0 < 0 and vy1 < 0
+    # The top particle leaves to the left, the right one downwards (seed 3.1.2): they meet with
+    # the line of centres at 45 degrees, so the velocities are exchanged along it.
+    np.testing.assert_allclose(sim.particles.velocity, [[-5.0, 0.0], [0.0, -5.0]], atol=1e-14)
     assert sim.counters.pair_collisions == 1
     np.testing.assert_allclose(sim.momentum(), [-5.0, -5.0], rtol=0, atol=1e-14)
     assert sim.energy().total == pytest.approx(25.0, rel=1e-14)
@@ -98,14 +98,63 @@ def _max_energy_error(name: str, dt: float, time: float) -> float:
     return drift.max_rel_drift
 
 
-@pytest.mark.parametrize("name", ["orbit", "charged-like", "charged-opposite"])
+@pytest.mark.parametrize("name", ["orbit", "charged-like"])
 def test_halving_dt_cuts_the_energy_error_about_four_times(name):
     """Leapfrog's bounded energy error is O(dt^2), so the ratio is 4 up to higher-order terms.
-    charged-like bounces off walls and charged-opposite collides: with the kick-timing correction
-    at each collision (kernels/events.py) those events keep the error O(dt^2) too."""
+    charged-like also bounces off walls, where the kick-timing correction (kernels/events.py)
+    keeps the error O(dt^2)."""
     coarse = _max_energy_error(name, 0.02, 10.0)
     fine = _max_energy_error(name, 0.01, 10.0)
     assert 3.5 < coarse / fine < 4.5
+
+
+def _worst_error_of_one_collision(dt: float) -> float:
+    """charged-opposite's pair, started a little further apart each time so that their contact
+    falls at every phase within a step; the largest relative energy error after it."""
+    worst = 0.0
+    for offset in np.linspace(0.0, 0.2, 24):
+        particles = cd.Particles(
+            [[-5.0 - offset, 0.0], [5.0 + offset, 0.0]], [[2.0, 0.0], [-2.0, 0.0]], charge=[1, -1]
+        )
+        sim = cd.Simulation(cd.Box(20, 20), particles, forces=[cd.Coulomb(k=5.0)], dt=dt)
+        e0 = sim.energy().total
+        sim.run(time=3.0)
+        assert sim.counters.pair_collisions == 1
+        worst = max(worst, abs(sim.energy().total - e0) / abs(e0))
+    return worst
+
+
+def test_collision_under_forces_keeps_the_energy_error_second_order():
+    """A single collision's energy error depends on where in the step the contact falls, so one
+    run's ratio is noisy; its worst case over the phase is not. Plain reflection inside a kicked
+    step leaves an O(dt) error (ratio 2 when dt halves); the kick-timing correction makes it
+    O(dt^2): measured 3.7 at these dt, approaching 4 as dt shrinks."""
+    assert 3.2 < _worst_error_of_one_collision(0.005) / _worst_error_of_one_collision(0.0025) < 4.5
+
+
+def test_touching_rack_breaks_without_stalling():
+    """A rack with no gaps: the cue's impulse runs through disks all in contact, where the
+    response leaves some pairs approaching by round-off only; those are not collisions."""
+    sim = cd.load("pool-break", **{"particles.0.gap": 0.0})
+    watch = OverlapWatch()
+    sim.observers.append(watch)
+    sim.run(time=5.0)
+    assert watch.first_pair == (-1, -1)
+    assert sim.energy().total == pytest.approx(5000.0, rel=1e-13)
+    assert sim.counters.pair_collisions > 1000
+
+
+def test_runaway_velocity_stops_the_run_with_a_clear_error():
+    sim = cd.Simulation(
+        cd.Box(20, 20), cd.Particles([[0.0, 0.0], [3.0, 0.0]], [[1e300, 0], [0, 1]])
+    )
+    with pytest.raises(cd.SimulationError, match=r"step 1 .*particle 0 .*run away"):
+        sim.run(time=1.0)
+
+
+def test_an_empty_vessel_runs():
+    sim = cd.load("gas", n=0).run(time=1.0)
+    assert sim.particles.n == 0 and sim.energy().total == 0.0 and sim.escaped() == 0
 
 
 def test_charged_like_never_touch():

@@ -292,4 +292,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _fail(f"input: {message}", 2)
     except (typer.Abort, KeyboardInterrupt):
         return _fail("interrupted", 130)
+    except OSError as exc:  # e.g. the output stream is full or closed
+        return _fail(f"output: {exc.strerror or exc}", 1)
     return result if isinstance(result, int) else 0

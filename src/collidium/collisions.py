@@ -20,6 +20,7 @@ from typing import Literal, Protocol
 import numpy as np
 
 from collidium.containers import Box
+from collidium.errors import SimulationError
 from collidium.kernels import events, stepper, walls
 from collidium.kernels.cells import grid_shape, neighbour_table
 from collidium.state import FloatArray, IntArray, Particles
@@ -85,6 +86,24 @@ def _free_flight(particles: Particles, box: Box, dt: float, tally: IntArray) -> 
             particles.position, particles.velocity, particles.radius,
             0.5 * box.width, 0.5 * box.height, dt, tally[1:],
         )  # fmt: skip
+
+
+#: Box sides a particle may cross in one drift before the state counts as runaway (the event
+#: count of a drift grows with it; legitimate runs stay many orders of magnitude below).
+MAX_CROSSINGS_PER_DRIFT = 1e9
+
+
+def _refuse_runaway(particles: Particles, box: Box, dt: float) -> None:
+    """Stop before an event-driven drift whose event count would be astronomical."""
+    if particles.n == 0:
+        return
+    fastest = int(np.argmax(np.abs(particles.velocity).max(axis=1)))
+    speed = float(np.abs(particles.velocity[fastest]).max())
+    if speed * dt > MAX_CROSSINGS_PER_DRIFT * min(box.width, box.height):
+        raise SimulationError(
+            f"particle {fastest} moves at {speed:.3g} m/s, over {MAX_CROSSINGS_PER_DRIFT:.0g} box "
+            "sides per step: the state has run away; try a smaller dt or softening"
+        )
 
 
 class NoCollisions:
@@ -164,6 +183,7 @@ class ExactCollisions:
             and self._written is not None
             and np.array_equal(self._written, particles.position)
             and np.array_equal(self._state["velocity"], particles.velocity)
+            and np.array_equal(self._state["radius"], particles.radius)
         )
 
     def _rebuild(self, particles: Particles, box: Box, now: float) -> dict[str, np.ndarray]:
@@ -173,6 +193,7 @@ class ExactCollisions:
         s = {
             "position": particles.position.copy(),
             "velocity": particles.velocity.copy(),
+            "radius": particles.radius.copy(),  # what the queue was predicted with
             "stamp": np.empty(n),
             "geometry": np.array(
                 [0.5 * box.width, 0.5 * box.height, box.width / ncx, box.height / ncy]
@@ -207,13 +228,14 @@ class ExactCollisions:
         acceleration: FloatArray | None = None,
     ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
+        _refuse_runaway(particles, box, dt)
         if not self._is_current(particles):
             self._state = self._rebuild(particles, box, now)
             self.rebuilds += 1
         s = self._state
         assert s is not None
         until = now + dt
-        self.events += events.run_events(
+        processed = events.run_events(
             until, s["position"], s["velocity"], s["stamp"], particles.mass, particles.radius,
             particles.image, s["geometry"], s["grid"], s["cell_of"], s["head"], s["next"],
             s["prev"], s["cells"], s["shifts"], s["collisions"], s["event_time"],
@@ -221,6 +243,15 @@ class ExactCollisions:
             s["heap_where"], tally, _NO_ACCELERATION if acceleration is None else acceleration,
             now + 0.5 * dt,
         )  # fmt: skip
+        if processed < 0:
+            self._state = None  # the queue is unusable; a later drift rebuilds it
+            stuck = -1 - processed
+            raise SimulationError(
+                f"particle {stuck}: time stopped advancing in the event-driven drift near "
+                f"t = {until:.6g} s (velocity {s['velocity'][stuck].tolist()} m/s); "
+                "the state has run away: try a smaller dt or softening"
+            )
+        self.events += processed
         events.synchronise(until, s["position"], s["velocity"], s["stamp"], particles.position)
         particles.velocity[...] = s["velocity"]
         self._written = particles.position.copy()

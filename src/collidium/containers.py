@@ -94,8 +94,10 @@ class Box:
             raise InputError(
                 "radius", f"diameter {2 * r} too large for a periodic box of side {limit}"
             )
-        if 2 * r > limit:
-            raise InputError("radius", f"diameter {2 * r} does not fit in a box of side {limit}")
+        if 2 * r >= limit:
+            raise InputError(
+                "radius", f"diameter {2 * r} must be smaller than the box side {limit}"
+            )
 
     def wrap(self, position: FloatArray) -> FloatArray:
         """Positions mapped into the primary cell (periodic); unchanged copy otherwise."""

@@ -31,6 +31,7 @@ def random_positions(
     *,
     existing: ArrayLike | None = None,
     existing_radius: ArrayLike | None = None,
+    periodic: bool = False,
     field: str = "particles.n",
     max_batches: int = MAX_BATCHES,
 ) -> FloatArray:
@@ -55,6 +56,8 @@ def random_positions(
         Centres in m of disks already in the box that the new ones must not overlap.
     existing_radius : float or array_like, shape (M,), optional
         Radii in m of the existing disks (default 0).
+    periodic : bool
+        The box is periodic: new disks must also clear the images of existing disks near an edge.
     field : str
         Field named in the error when the disks do not fit.
     max_batches : int
@@ -78,6 +81,10 @@ def random_positions(
     r_max = float(radii.max(initial=0.0))
     if n == 0:
         return np.zeros((0, 2))
+    if periodic and m:
+        reach = r_max + float(old_radii.max())
+        old, old_radii = _with_edge_images(old, old_radii, width, height, reach)
+        m = old.shape[0]
     if 2.0 * r_max > min(width, height):
         raise InputError(
             field, f"disks of radius {r_max:g} m do not fit in a {width:g} x {height:g} box"
@@ -87,7 +94,13 @@ def random_positions(
     all_radii = np.concatenate([old_radii, radii])
     position = np.zeros((m + n, 2))
     position[:m] = old
-    cell = max(2.0 * float(all_radii.max(initial=0.0)), math.sqrt(width * height / (m + n)))
+    # At least a diameter, about one disk per cell, and never more than ~4 (m + n) cells even in
+    # a very elongated box.
+    cell = max(
+        2.0 * float(all_radii.max(initial=0.0)),
+        math.sqrt(width * height / (m + n)),
+        max(width, height) / (4 * (m + n) + 16),
+    )
     ncx = max(1, math.ceil(width / cell))
     ncy = max(1, math.ceil(height / cell))
     lo = np.array([-0.5 * width, -0.5 * height])
@@ -109,6 +122,24 @@ def random_positions(
         f"{width:g} x {height:g} box after {max_batches} tries; use fewer or smaller disks or a "
         "larger box",
     )
+
+
+def _with_edge_images(
+    position: FloatArray, radius: FloatArray, width: float, height: float, reach: float
+) -> tuple[FloatArray, FloatArray]:
+    """Disks (M, 2) plus their periodic images that come within ``reach`` (m) of the box."""
+    size = np.array([width, height])
+    shifted = [position]
+    radii = [radius]
+    for sx in (-1, 0, 1):
+        for sy in (-1, 0, 1):
+            if sx == sy == 0:
+                continue
+            image = position + size * np.array([sx, sy])
+            near = (np.abs(image) <= 0.5 * size + reach).all(axis=1)
+            shifted.append(image[near])
+            radii.append(radius[near])
+    return np.concatenate(shifted), np.concatenate(radii)
 
 
 def _radii(value: float | ArrayLike, n: int, field: str) -> FloatArray:
@@ -175,7 +206,8 @@ def uniform_velocities(n: int, speed: float, rng: np.random.Generator) -> FloatA
     """
     if not math.isfinite(speed) or speed < 0:
         raise InputError("particles.speed", f"must be a finite number >= 0, got {speed!r}")
-    return rng.uniform(-speed, speed, size=(n, 2))
+    # Scale draws in [-1, 1): rng.uniform(-speed, speed) would overflow for speed near 1e308.
+    return speed * rng.uniform(-1.0, 1.0, size=(n, 2))
 
 
 def balanced_charges(n: int, charge: float, rng: np.random.Generator) -> FloatArray:

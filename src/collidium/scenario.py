@@ -223,7 +223,7 @@ class RandomGroup(_Model):
         position = random_positions(
             self.n, self.radius, box.width, box.height, rng,
             existing=box.wrap(existing.position), existing_radius=existing.radius,
-            field=f"particles.{index}.n",
+            periodic=box.periodic, field=f"particles.{index}.n",
         )  # fmt: skip
         velocity = uniform_velocities(self.n, self.speed, rng)
         if self.charges == "balanced":

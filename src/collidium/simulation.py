@@ -32,6 +32,9 @@ from collidium.state import FloatArray, Particles
 
 WALL_NAMES = ("left", "right", "bottom", "top")
 
+#: Most steps one `Simulation.run` call accepts (a guard against a mistyped time or dt).
+MAX_STEPS = 1e12
+
 
 @dataclass(frozen=True)
 class Energy:
@@ -102,7 +105,7 @@ class Simulation:
         self.particles = particles
         self._dt = float(dt)
         self._time_origin = (0.0, 0)  # (time, steps) when dt was last set
-        self.collisions: CollisionMode = collisions
+        self._collisions: CollisionMode = collisions
         self.seed = seed
         self.rng = np.random.default_rng(seed)
         self.name = name or "custom"
@@ -139,6 +142,11 @@ class Simulation:
         return t0 + (self.steps - k0) * self._dt
 
     @property
+    def collisions(self) -> CollisionMode:
+        """Collision mode, fixed at construction: "exact", "step" or "off"."""
+        return self._collisions
+
+    @property
     def forces(self) -> tuple[Coulomb, ...]:
         """The forces acting."""
         return self._field.forces
@@ -170,9 +178,10 @@ class Simulation:
         if self._field.active:
             self._field.evaluate(self.particles, self.container)
         if progress:
+            from rich.console import Console
             from rich.progress import Progress
 
-            with Progress(transient=True) as bar:
+            with Progress(console=Console(stderr=True), transient=True) as bar:
                 task = bar.add_task(f"{self.name}", total=count)
                 stride = max(1, count // 200)
                 for k in range(count):
@@ -185,10 +194,13 @@ class Simulation:
         return self
 
     def _step(self) -> None:
-        self._integrator.step(
-            self.particles, self.container, self._field, self._drift, self.time, self.dt,
-            self._tally,
-        )  # fmt: skip
+        try:
+            self._integrator.step(
+                self.particles, self.container, self._field, self._drift, self.time, self.dt,
+                self._tally,
+            )  # fmt: skip
+        except SimulationError as exc:
+            raise SimulationError(f"step {self.steps + 1} (t = {self.time:.6g} s): {exc}") from None
         self.steps += 1
         self._audit()
         for observer in self.observers:
@@ -270,13 +282,20 @@ def _step_count(time: float | None, steps: int | None, dt: float) -> int:
     if (time is None) == (steps is None):
         raise InputError("time", "give exactly one of time and steps")
     if steps is not None:
-        if isinstance(steps, bool) or int(steps) != steps or steps < 0:
-            raise InputError("steps", f"must be a whole number >= 0, got {steps!r}")
+        if isinstance(steps, bool) or int(steps) != steps or not 0 <= steps <= MAX_STEPS:
+            raise InputError(
+                "steps", f"must be a whole number in [0, {MAX_STEPS:.0e}], got {steps!r}"
+            )
         return int(steps)
     assert time is not None
     if not math.isfinite(time) or time < 0:
         raise InputError("time", f"must be a finite number >= 0, got {time!r}")
-    return round(time / dt)
+    count = time / dt
+    if count > MAX_STEPS:
+        raise InputError(
+            "time", f"{time:g} s is {count:.3g} steps of {dt:g} s; at most {MAX_STEPS:.0e}"
+        )
+    return round(count)
 
 
 def _check_setup(

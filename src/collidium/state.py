@@ -93,7 +93,8 @@ class Particles:
 
     def _check_values(self) -> None:
         for name in ("position", "velocity", "mass", "radius", "charge"):
-            bad = np.flatnonzero(~np.isfinite(getattr(self, name)).reshape(self.n, -1).all(axis=1))
+            values = getattr(self, name).reshape(self.n, -1 if self.n else 1)
+            bad = np.flatnonzero(~np.isfinite(values).all(axis=1))
             if bad.size:
                 raise InputError(name, f"not finite (NaN or infinity) for particle {int(bad[0])}")
         if (self.mass <= 0).any():

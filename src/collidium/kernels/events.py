@@ -35,8 +35,15 @@ PAIR_COLLISIONS = 0
 WALL_HITS = 1  # 4 entries: left, right, bottom, top wall
 
 
+#: Relative size, against the particles' speeds, of an approach too slow to be anything but
+#: round-off (see `contact_delay`).
+CONTACT_SLACK = 1e-12
+
+
 @numba.njit(cache=True, inline="always")
-def contact_delay(dx: float, dy: float, dvx: float, dvy: float, sigma: float) -> float:
+def contact_delay(
+    dx: float, dy: float, dvx: float, dvy: float, sigma: float, slack: float = 0.0
+) -> float:
     """Time until two disks touch, or inf.
 
     Parameters
@@ -47,19 +54,24 @@ def contact_delay(dx: float, dy: float, dvx: float, dvy: float, sigma: float) ->
         Relative velocity ``v_j - v_i`` in m/s.
     sigma : float
         Contact distance ``r_i + r_j`` in m.
+    slack : float
+        For a pair already in contact: the approach ``-(dx . dv)``, in m^2/s, below which it is
+        taken for round-off. The elastic response reverses the normal velocity only up to
+        round-off, so without this a touching cluster (a rack with no gaps) could collide again
+        and again at the same instant.
 
     Returns
     -------
     float
-        Delay in s (0 for an approaching pair already in contact by round-off), inf if the pair is
-        not approaching or misses.
+        Delay in s (0 for a pair in contact that approaches by more than ``slack``), inf if the
+        pair is not approaching or misses.
     """
     b = dx * dvx + dy * dvy
     if b >= 0.0:
         return math.inf
     gap = dx * dx + dy * dy - sigma * sigma
     if gap <= 0.0:
-        return 0.0
+        return 0.0 if -b > slack else math.inf
     dv2 = dvx * dvx + dvy * dvy
     disc = b * b - dv2 * gap
     if disc <= 0.0:
@@ -164,6 +176,7 @@ def predict(
     ``geometry`` is ``[half_width, half_height, cell_width, cell_height]`` in m; ``grid`` is
     ``[ncx, ncy, periodic]``. Ties go to the first found in a fixed order (walls, cells, then the
     partner with the lowest index), so the outcome does not depend on the order of cell lists.
+
     """
     hw = geometry[0]
     hh = geometry[1]
@@ -214,6 +227,7 @@ def predict(
                     best, kind, other = delay, CELL, 2 * d
 
         if ri > 0.0:
+            speed_i = abs(vxi) + abs(vyi)
             width = 2.0 * hw
             height = 2.0 * hh
             for q in range(9):
@@ -228,9 +242,12 @@ def predict(
                         lag_j = now - stamp[j]
                         dx = position[j, 0] + velocity[j, 0] * lag_j + ox - xi
                         dy = position[j, 1] + velocity[j, 1] * lag_j + oy - yi
+                        sigma = ri + radius[j]
+                        speeds = speed_i + abs(velocity[j, 0]) + abs(velocity[j, 1])
                         delay = contact_delay(
-                            dx, dy, velocity[j, 0] - vxi, velocity[j, 1] - vyi, ri + radius[j]
-                        )
+                            dx, dy, velocity[j, 0] - vxi, velocity[j, 1] - vyi, sigma,
+                            CONTACT_SLACK * sigma * speeds,
+                        )  # fmt: skip
                         if delay < best or (delay == best and kind == PAIR and j < other):
                             best, kind, other = delay, PAIR, j
                     j = next_[j]
@@ -371,18 +388,28 @@ def run_events(
     Returns
     -------
     int
-        Number of events processed (including cell crossings and stale events).
+        Number of events processed (including cell crossings and stale events), or ``-1 - i``
+        if time stopped advancing at particle i: far more events at one instant than simultaneous
+        contacts allow, which only a runaway state (huge or infinite velocities) produces.
     """
     processed = 0
     n = position.shape[0]
     if n == 0:
         return 0
+    instant = -math.inf
+    at_instant = 0
     while True:
         i = heap[0]
         t = heap_keys[0]
         if t > until:
             break
         processed += 1
+        if t > instant:
+            instant = t
+            at_instant = 0
+        at_instant += 1
+        if at_instant > 100 * n + 10_000:
+            return -1 - i
         kind = event_kind[i]
         if kind == PAIR:
             j = event_other[i]
@@ -408,8 +435,8 @@ def run_events(
                 tally[PAIR_COLLISIONS] += 1
                 predict(
                     j, t, position, velocity, stamp, radius, geometry, grid, cell_of, head,
-                    next_, cells, shifts, collisions, event_time, event_kind, event_other,
-                    event_stamp,
+                    next_, cells, shifts, collisions, event_time, event_kind,
+                    event_other, event_stamp,
                 )  # fmt: skip
                 heap_update(j, event_time[j], heap, heap_keys, heap_where)
         elif kind == WALL:

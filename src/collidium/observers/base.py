@@ -6,6 +6,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
+from collidium.errors import InputError
+
 if TYPE_CHECKING:
     from collidium.simulation import Simulation
 
@@ -23,6 +25,10 @@ class Every:
     """
 
     period: int = 1
+
+    def __post_init__(self) -> None:
+        if isinstance(self.period, bool) or not isinstance(self.period, int) or self.period < 1:
+            raise InputError("trigger.period", f"must be a whole number >= 1, got {self.period!r}")
 
     def __call__(self, step: int) -> bool:
         return step % self.period == 0
