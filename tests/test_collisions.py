@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import collidium as cd
-from collidium.collisions import ExactCollisions
+from collidium.collisions import ExactCollisions, make_drift
 
 
 def _engine(sim: cd.Simulation) -> ExactCollisions:
@@ -72,3 +73,12 @@ def test_engine_follows_a_radius_change_between_runs():
     sim.particles.radius[:] = 0.4  # contact now 0.2 m sooner
     sim.run(time=0.03)
     assert sim.counters.pair_collisions == 1
+
+
+def test_event_engine_stops_when_time_no_longer_advances():
+    """At t = 1e17 s a float cannot resolve the next wall hit (about 1 s away): events would
+    repeat at one instant for ever. The engine notices and raises instead of hanging."""
+    box = cd.Box(2, 2)
+    particles = cd.Particles([[0.0, 0.0]], [[3.0, 0.0]], radius=0.5)
+    with pytest.raises(cd.SimulationError, match="time stopped advancing"):
+        make_drift("exact").drift(particles, box, 1e17, 100.0, np.zeros(5, dtype=np.int64))
