@@ -633,6 +633,15 @@ def _clean_loc(loc: tuple[int | str, ...]) -> list[int | str]:
     return out
 
 
+#: pydantic's bound errors: (the comparison, the context key holding the bound).
+_BOUNDS = {
+    "greater_than": (">", "gt"),
+    "greater_than_equal": (">=", "ge"),
+    "less_than": ("<", "lt"),
+    "less_than_equal": ("<=", "le"),
+}
+
+
 def _reason(error: Any) -> tuple[str, str]:
     kind = error["type"]
     loc = _clean_loc(error["loc"])
@@ -650,12 +659,9 @@ def _reason(error: Any) -> tuple[str, str]:
         expected = [name for name, model in _TAGGED.items() if tag in model.model_fields]
         what = "missing" if kind == "union_tag_not_found" else f"unknown value {ctx.get('tag')!r}"
         return f"{path}.{tag}", f"{what}; choose from {', '.join(expected)}"
-    if kind == "greater_than":
-        return path, f"must be > {_num(ctx['gt'])}, got {got}"
-    if kind == "greater_than_equal":
-        return path, f"must be >= {_num(ctx['ge'])}, got {got}"
-    if kind == "less_than_equal":
-        return path, f"must be <= {_num(ctx['le'])}, got {got}"
+    if kind in _BOUNDS:
+        sign, key = _BOUNDS[kind]
+        return path, f"must be {sign} {_num(ctx[key])}, got {got}"
     if kind == "too_short":
         return path, f"needs at least {ctx['min_length']} entries, got {ctx['actual_length']}"
     if kind == "too_long":
