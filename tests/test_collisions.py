@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import collidium as cd
-from collidium.collisions import ExactCollisions, make_drift
+from collidium.collisions import ExactCollisions, Tally, make_drift
 
 
 def _engine(sim: cd.Simulation) -> ExactCollisions:
@@ -81,4 +81,4 @@ def test_event_engine_stops_when_time_no_longer_advances():
     box = cd.Box(2, 2)
     particles = cd.Particles([[0.0, 0.0]], [[3.0, 0.0]], radius=0.5)
     with pytest.raises(cd.SimulationError, match="time stopped advancing"):
-        make_drift("exact").drift(particles, box, 1e17, 100.0, np.zeros(5, dtype=np.int64))
+        make_drift("exact").drift(particles, box, 1e17, 100.0, Tally())

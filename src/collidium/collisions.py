@@ -9,12 +9,13 @@ Three modes (DESIGN.md section 2):
   overlapping approaching pairs resolved one by one in index order (`kernels/stepper.py`).
 - `NoCollisions` (``"off"``): disks pass through each other; walls still reflect exactly.
 
-Each mode moves ``particles`` from time ``now`` to ``now + dt`` in place and adds to ``tally``
-(int64, shape (5,)): pair collisions, then hits on the left, right, bottom and top wall.
+Each mode moves ``particles`` from time ``now`` to ``now + dt`` in place and adds what happened
+to a `Tally`.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from typing import Literal, Protocol
 
 import numpy as np
@@ -29,6 +30,32 @@ CollisionMode = Literal["exact", "step", "off"]
 COLLISION_MODES: tuple[CollisionMode, ...] = ("exact", "step", "off")
 
 
+def _zeros_int() -> IntArray:
+    return np.zeros(5, dtype=np.int64)
+
+
+def _zeros_float() -> FloatArray:
+    return np.zeros(5)
+
+
+@dataclass
+class Tally:
+    """Running sums kept by the drift modes since a simulation started.
+
+    Attributes
+    ----------
+    counts : ndarray of int64, shape (5,)
+        Pair collisions, then hits on the left, right, bottom and top wall.
+    impulse : ndarray of float64, shape (5,)
+        The collision virial ``sum r_ij . dp_i`` over pair collisions (kg m^2/s; ``r_ij`` the
+        centre-to-centre vector at contact, ``dp_i`` the impulse on i), then the normal momentum
+        received by the left, right, bottom and top wall (kg m/s).
+    """
+
+    counts: IntArray = field(default_factory=_zeros_int)
+    impulse: FloatArray = field(default_factory=_zeros_float)
+
+
 class Drift(Protocol):
     """A drift mode: moves particles over one step and counts collisions."""
 
@@ -38,10 +65,10 @@ class Drift(Protocol):
         box: Box,
         now: float,
         dt: float,
-        tally: IntArray,
+        tally: Tally,
         acceleration: FloatArray | None = None,
     ) -> None:
-        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place.
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place, adding to ``tally``.
 
         ``acceleration`` (N, 2), in m/s^2, is that of the step's half kicks when forces act; a mode
         may use it to time collisions within the step consistently with the kicks.
@@ -76,15 +103,15 @@ class _Grid:
         self.prev = np.empty(n, dtype=np.int64)
 
 
-def _free_flight(particles: Particles, box: Box, dt: float, tally: IntArray) -> None:
+def _free_flight(particles: Particles, box: Box, dt: float, tally: Tally) -> None:
     if box.periodic:
         walls.drift_periodic(
             particles.position, particles.velocity, particles.image, box.width, box.height, dt
         )
     else:
         walls.drift_reflecting(
-            particles.position, particles.velocity, particles.radius,
-            0.5 * box.width, 0.5 * box.height, dt, tally[1:],
+            particles.position, particles.velocity, particles.radius, particles.mass,
+            0.5 * box.width, 0.5 * box.height, dt, tally.counts[1:], tally.impulse[1:],
         )  # fmt: skip
 
 
@@ -116,7 +143,7 @@ class NoCollisions:
         box: Box,
         now: float,
         dt: float,
-        tally: IntArray,
+        tally: Tally,
         acceleration: FloatArray | None = None,
     ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
@@ -140,7 +167,7 @@ class StepCollisions:
         box: Box,
         now: float,
         dt: float,
-        tally: IntArray,
+        tally: Tally,
         acceleration: FloatArray | None = None,
     ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
@@ -156,9 +183,9 @@ class StepCollisions:
             if count <= self._pairs.shape[0]:
                 break
             self._pairs = np.empty(2 * count, dtype=np.int64)
-        tally[0] += stepper.resolve_pairs(
+        tally.counts[0] += stepper.resolve_pairs(
             self._pairs[:count], particles.position, particles.velocity, particles.mass,
-            box.width, box.height, box.periodic,
+            box.width, box.height, box.periodic, tally.impulse,
         )  # fmt: skip
 
 
@@ -225,7 +252,7 @@ class ExactCollisions:
         box: Box,
         now: float,
         dt: float,
-        tally: IntArray,
+        tally: Tally,
         acceleration: FloatArray | None = None,
     ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
@@ -241,8 +268,8 @@ class ExactCollisions:
             particles.image, s["geometry"], s["grid"], s["cell_of"], s["head"], s["next"],
             s["prev"], s["cells"], s["shifts"], s["collisions"], s["event_time"],
             s["event_kind"], s["event_other"], s["event_stamp"], s["heap"], s["heap_keys"],
-            s["heap_where"], tally, _NO_ACCELERATION if acceleration is None else acceleration,
-            now + 0.5 * dt,
+            s["heap_where"], tally.counts, tally.impulse,
+            _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
         )  # fmt: skip
         if processed < 0:
             self._state = None  # the queue is unusable; a later drift rebuilds it

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from collidium.collisions import Drift
+from collidium.collisions import Drift, Tally
 from collidium.containers import Box
 from collidium.forces import ForceField
-from collidium.state import IntArray, Particles
+from collidium.state import Particles
 
 
 class Leapfrog:
@@ -25,7 +25,7 @@ class Leapfrog:
         drift: Drift,
         now: float,
         dt: float,
-        tally: IntArray,
+        tally: Tally,
     ) -> None:
         """Advance ``particles`` in place from time ``now`` by ``dt`` (s).
 

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from collidium.collisions import COLLISION_MODES, CollisionMode, make_drift
+from collidium.collisions import COLLISION_MODES, CollisionMode, Tally, make_drift
 from collidium.containers import OUTSIDE_TOLERANCE, Box
 from collidium.errors import InputError, SimulationError
 from collidium.forces import Coulomb, ForceField
@@ -115,7 +115,7 @@ class Simulation:
         self._field = ForceField(tuple(forces))
         self._drift = make_drift(collisions)
         self._integrator = Leapfrog()
-        self._tally = np.zeros(5, dtype=np.int64)
+        self.tally = Tally()
         if container.periodic:
             wrapped = container.wrap(particles.position)
             size = container.size
@@ -197,7 +197,7 @@ class Simulation:
         try:
             self._integrator.step(
                 self.particles, self.container, self._field, self._drift, self.time, self.dt,
-                self._tally,
+                self.tally,
             )  # fmt: skip
         except SimulationError as exc:
             raise SimulationError(f"step {self.steps + 1} (t = {self.time:.6g} s): {exc}") from None
@@ -244,8 +244,8 @@ class Simulation:
     @property
     def counters(self) -> Counters:
         """Pair collisions and wall hits (per wall) since the start."""
-        hits = {name: int(self._tally[1 + k]) for k, name in enumerate(WALL_NAMES)}
-        return Counters(int(self._tally[0]), hits)
+        hits = {name: int(self.tally.counts[1 + k]) for k, name in enumerate(WALL_NAMES)}
+        return Counters(int(self.tally.counts[0]), hits)
 
     def escaped(self) -> int:
         """Number of particles outside the vessel (always 0 unless something is badly wrong)."""

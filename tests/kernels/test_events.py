@@ -40,12 +40,13 @@ def test_engine_matches_brute_force_twin(rng, boundary, width, duration):
     )
     sim.run(steps=7)
     twin_position, twin_velocity = position.copy(), velocity.copy()
-    pairs, walls = reference.event_drift(
+    pairs, walls, virial, wall_impulse = reference.event_drift(
         twin_position, twin_velocity, mass, radius, np.array([width, width]) / 2, duration,
         periodic=boundary == "periodic",
     )  # fmt: skip
     assert pairs > 5
     assert sim.counters.pair_collisions == pairs
     assert sim.counters.wall_collisions == walls
+    np.testing.assert_allclose(sim.tally.impulse, [virial, *wall_impulse], rtol=1e-9)
     np.testing.assert_allclose(sim.unwrapped_position(), twin_position, rtol=0, atol=1e-9 * width)
     np.testing.assert_allclose(sim.particles.velocity, twin_velocity, rtol=0, atol=1e-8 * 10)

@@ -32,10 +32,15 @@ def test_overlapping_pairs_resolved_like_the_twin(rng):
     )  # fmt: skip
     assert count > 20
     got_velocity = velocity.copy()
-    done = resolve_pairs(out[:count], position, got_velocity, mass, width, width, False)
+    virial = np.zeros(1)
+    done = resolve_pairs(out[:count], position, got_velocity, mass, width, width, False, virial)
     want_velocity = velocity.copy()
-    assert done == reference.step_collisions(position, want_velocity, mass, radius)
+    want_done, want_virial = reference.step_collisions(position, want_velocity, mass, radius)
+    assert done == want_done
     np.testing.assert_allclose(got_velocity, want_velocity, rtol=1e-13, atol=1e-13)
+    # Repulsive impulses along the line of centres: every term of the virial is positive.
+    assert virial[0] > 0
+    np.testing.assert_allclose(virial[0], want_virial, rtol=1e-12)
 
 
 def test_first_overlap_equals_twin(rng):

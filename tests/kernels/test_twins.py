@@ -16,11 +16,16 @@ def test_reflecting_drift_equals_twin(rng):
     radius = rng.uniform(0.0, 0.5, n)
     position = rng.uniform(-4.4, 4.4, (n, 2))
     velocity = rng.normal(0.0, 30.0, (n, 2))  # many bounces per step
+    mass = rng.uniform(0.5, 2.0, n)
     got_p, got_v, hits = position.copy(), velocity.copy(), np.zeros(4, np.int64)
-    drift_reflecting(got_p, got_v, radius, 5.0, 5.0, 0.7, hits)
+    impulse = np.zeros(4)
+    drift_reflecting(got_p, got_v, radius, mass, 5.0, 5.0, 0.7, hits, impulse)
     want_p, want_v = position.copy(), velocity.copy()
-    want_hits = reference.drift_reflecting(want_p, want_v, radius, np.array([5.0, 5.0]), 0.7)
+    want_hits, want_impulse = reference.drift_reflecting(
+        want_p, want_v, radius, mass, np.array([5.0, 5.0]), 0.7
+    )
     np.testing.assert_array_equal(hits, want_hits)
+    np.testing.assert_allclose(impulse, want_impulse, rtol=1e-13)
     np.testing.assert_array_equal(got_v, want_v)
     # Folding once versus bouncing one span at a time: round-off of order (bounces) ulp.
     np.testing.assert_allclose(got_p, want_p, rtol=0, atol=1e-12)

@@ -14,11 +14,15 @@ def test_wall_mirrors_the_normal_component():
     position = np.array([[9.0, 0.0]])
     velocity = np.array([[4.0, 3.0]])
     hits = np.zeros(4, dtype=np.int64)
-    drift_reflecting(position, velocity, np.array([0.5]), 10.0, 10.0, 0.25, hits)
+    impulse = np.zeros(4)
+    drift_reflecting(
+        position, velocity, np.array([0.5]), np.array([2.0]), 10.0, 10.0, 0.25, hits, impulse
+    )
     # Contact at x = 9.5 after 0.125 s, then 0.125 s back: x = 9.0; y untouched.
     np.testing.assert_allclose(position, [[9.0, 0.75]], rtol=0, atol=1e-15)
     np.testing.assert_array_equal(velocity, [[-4.0, 3.0]])
     np.testing.assert_array_equal(hits, [0, 1, 0, 0])
+    np.testing.assert_array_equal(impulse, [0.0, 2 * 2.0 * 4.0, 0.0, 0.0])  # 2 m |v_x|
 
 
 @settings(max_examples=200, deadline=None)

@@ -30,9 +30,9 @@ PAIR = 1
 WALL = 2
 CELL = 3
 
-#: Index of each entry of the ``tally`` array.
-PAIR_COLLISIONS = 0
-WALL_HITS = 1  # 4 entries: left, right, bottom, top wall
+#: Index of each entry of the ``tally`` array (counts) and of the ``impulse`` array (sums).
+PAIR_COLLISIONS = 0  # tally: pair collisions; impulse: pair virial sum of r_ij . dp_i (kg m^2/s)
+WALL_HITS = 1  # 4 entries: left, right, bottom, top wall (tally: hits; impulse: kg m/s received)
 
 
 #: Relative size, against the particles' speeds, of an approach too slow to be anything but
@@ -368,6 +368,7 @@ def run_events(
     heap_keys: np.ndarray,
     heap_where: np.ndarray,
     tally: np.ndarray,
+    impulse: np.ndarray,
     acceleration: np.ndarray,
     midpoint: float,
 ) -> int:
@@ -379,6 +380,9 @@ def run_events(
         End of the drift, in s (absolute simulation time).
     tally : ndarray of int64, shape (5,)
         Incremented: pair collisions, then hits on the left, right, bottom, top wall.
+    impulse : ndarray of float64, shape (5,)
+        Incremented: the collision virial ``sum r_ij . dp_i`` (kg m^2/s, ``r_ij = x_i - x_j`` at
+        contact, ``dp_i`` the impulse on i), then the momentum given to each wall (kg m/s).
     acceleration : ndarray, shape (N, 2) or (0, 2)
         With forces, the acceleration of the step's half kicks (m/s^2), and ``midpoint`` the
         middle of the step (s): see `_pair_response`. Empty without forces.
@@ -426,6 +430,9 @@ def run_events(
                 v1x, v1y, v2x, v2y = _pair_response(
                     i, j, nx, ny, midpoint - t, mass, velocity, acceleration
                 )
+                impulse[PAIR_COLLISIONS] += mass[i] * (
+                    nx * (v1x - velocity[i, 0]) + ny * (v1y - velocity[i, 1])
+                )
                 velocity[i, 0] = v1x
                 velocity[i, 1] = v1y
                 velocity[j, 0] = v2x
@@ -446,9 +453,9 @@ def run_events(
             half = geometry[d]
             # Snap to the contact point so round-off never leaves the disk past the wall.
             position[i, d] = (half - radius[i]) if wall % 2 == 1 else (radius[i] - half)
-            velocity[i, d] = _wall_response(
-                velocity[i, d], wall % 2 == 1, i, d, midpoint - t, acceleration
-            )
+            before = velocity[i, d]
+            velocity[i, d] = _wall_response(before, wall % 2 == 1, i, d, midpoint - t, acceleration)
+            impulse[WALL_HITS + wall] += mass[i] * abs(velocity[i, d] - before)
             collisions[i] += 1
             tally[WALL_HITS + wall] += 1
         elif kind == CELL:

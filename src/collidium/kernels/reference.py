@@ -67,11 +67,11 @@ def first_overlap(position: FloatArray, radius: FloatArray) -> tuple[int, int]:
 
 def step_collisions(
     position: FloatArray, velocity: FloatArray, mass: FloatArray, radius: FloatArray
-) -> int:
+) -> tuple[int, float]:
     """Seed method, resolution part: every overlapping pair (i < j, index order) that is approaching
-    gets the elastic response. Velocities updated in place; returns the count (reflecting box).
-    Radius-0 particles take no part."""
-    done = 0
+    gets the elastic response. Velocities updated in place (reflecting box). Radius-0 particles take
+    no part. Returns the count and the collision virial ``sum r_ij . dp_i``."""
+    done, virial = 0, 0.0
     n = len(position)
     for i in range(n):
         for j in range(i + 1, n):
@@ -82,11 +82,13 @@ def step_collisions(
                 continue
             if np.dot(sep, velocity[i] - velocity[j]) >= 0:
                 continue
+            before = velocity[i].copy()
             velocity[i], velocity[j] = elastic_response(
                 mass[i], mass[j], position[i], position[j], velocity[i], velocity[j]
             )
+            virial += mass[i] * np.dot(sep, velocity[i] - before)
             done += 1
-    return done
+    return done, virial
 
 
 def event_drift(
@@ -97,14 +99,17 @@ def event_drift(
     half: FloatArray,
     duration: float,
     periodic: bool = False,
-) -> tuple[int, int]:
+) -> tuple[int, int, float, FloatArray]:
     """Event-driven hard disks, all pairs (and, if periodic, all 9 images) checked at every event.
 
-    Positions and velocities (N, 2) are updated in place (periodic positions are left unwrapped);
-    returns (pair collisions, wall hits).
+    Positions and velocities (N, 2) are updated in place (periodic positions are left unwrapped).
+    Returns (pair collisions, wall hits, collision virial ``sum r_ij . dp_i``, momentum received
+    by the left, right, bottom and top wall).
     """
     now = 0.0
     pairs = walls = 0
+    virial = 0.0
+    wall_impulse = np.zeros(4)
     while True:
         t_pair, i, j = _next_contact(position, velocity, radius, 2 * half, periodic)
         t_wall, k, d = (
@@ -113,19 +118,24 @@ def event_drift(
         best = min(t_pair, t_wall)
         if now + best > duration:
             position += velocity * (duration - now)
-            return pairs, walls
+            return pairs, walls, virial, wall_impulse
         position += velocity * best
         now += best
         if t_wall < t_pair:
+            wall_impulse[2 * d + (1 if velocity[k, d] > 0 else 0)] += (
+                2 * mass[k] * abs(velocity[k, d])
+            )
             velocity[k, d] = -velocity[k, d]
             walls += 1
         else:
             sep = position[i] - position[j]
             if periodic:
                 sep -= 2 * half * np.round(sep / (2 * half))
+            before = velocity[i].copy()
             velocity[i], velocity[j] = elastic_response(
                 mass[i], mass[j], sep, np.zeros(2), velocity[i], velocity[j]
             )
+            virial += mass[i] * np.dot(sep, velocity[i] - before)
             pairs += 1
 
 
@@ -170,22 +180,30 @@ def _next_contact(
 
 
 def drift_reflecting(
-    position: FloatArray, velocity: FloatArray, radius: FloatArray, half: FloatArray, dt: float
-) -> np.ndarray:
+    position: FloatArray,
+    velocity: FloatArray,
+    radius: FloatArray,
+    mass: FloatArray,
+    half: FloatArray,
+    dt: float,
+) -> tuple[np.ndarray, FloatArray]:
     """Twin of `walls.drift_reflecting`: straight drift, then bounce-by-bounce folding per
     coordinate. Updates position and velocity (N, 2) in place; returns hits per wall
-    (left, right, bottom, top)."""
+    (left, right, bottom, top) and the momentum each wall received."""
     hits = np.zeros(4, dtype=np.int64)
+    impulse = np.zeros(4)
     for i in range(len(position)):
         for d in range(2):
             lo, hi = radius[i] - half[d], half[d] - radius[i]
             x = position[i, d] + velocity[i, d] * dt
             v = velocity[i, d]
             while x < lo or x > hi:
-                hits[2 * d + (1 if x > hi else 0)] += 1
+                wall = 2 * d + (1 if x > hi else 0)
+                hits[wall] += 1
+                impulse[wall] += 2 * mass[i] * abs(v)
                 x, v = (2 * lo - x, -v) if x < lo else (2 * hi - x, -v)
             position[i, d], velocity[i, d] = x, v
-    return hits
+    return hits, impulse
 
 
 def drift_periodic(

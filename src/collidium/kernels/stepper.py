@@ -90,6 +90,7 @@ def resolve_pairs(
     width: float,
     height: float,
     periodic: bool,
+    impulse: np.ndarray,
 ) -> int:
     """Apply the elastic response to each listed pair that is approaching, in list order.
 
@@ -107,6 +108,8 @@ def resolve_pairs(
         Box sides in m.
     periodic : bool
         Use the minimum image for the line of centres.
+    impulse : ndarray of float64, shape (>=1,)
+        ``impulse[0]`` is incremented by the collision virial ``sum r_ij . dp_i`` (kg m^2/s).
 
     Returns
     -------
@@ -130,6 +133,7 @@ def resolve_pairs(
         v1x, v1y, v2x, v2y = elastic_response(
             mass[i], mass[j], nx, ny, velocity[i, 0], velocity[i, 1], velocity[j, 0], velocity[j, 1]
         )
+        impulse[0] += mass[i] * (nx * (v1x - velocity[i, 0]) + ny * (v1y - velocity[i, 1]))
         velocity[i, 0] = v1x
         velocity[i, 1] = v1y
         velocity[j, 0] = v2x

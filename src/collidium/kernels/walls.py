@@ -52,10 +52,12 @@ def drift_reflecting(
     position: np.ndarray,
     velocity: np.ndarray,
     radius: np.ndarray,
+    mass: np.ndarray,
     half_width: float,
     half_height: float,
     dt: float,
     wall_hits: np.ndarray,
+    wall_impulse: np.ndarray,
 ) -> None:
     """Move every particle by ``velocity * dt`` and fold it back inside the walls.
 
@@ -65,12 +67,16 @@ def drift_reflecting(
         Updated in place (m, m/s).
     radius : ndarray, shape (N,)
         Radii in m (a disk bounces when its rim touches a wall).
+    mass : ndarray, shape (N,)
+        Masses in kg (for the momentum given to the walls).
     half_width, half_height : float
         Half sides of the box in m.
     dt : float
         Time step in s.
     wall_hits : ndarray of int64, shape (4,)
         Incremented per bounce on the left, right, bottom, top wall.
+    wall_impulse : ndarray of float64, shape (4,)
+        Incremented by the momentum each wall receives, ``2 m |v|`` per bounce (kg m/s).
     """
     half = (half_width, half_height)
     for i in range(position.shape[0]):
@@ -86,8 +92,11 @@ def drift_reflecting(
                 # Bounces alternate between the two walls, starting with the one moved towards.
                 first = 2 * d + (1 if moving_up else 0)
                 other = 2 * d + (0 if moving_up else 1)
+                kick = 2.0 * mass[i] * abs(v)
                 wall_hits[first] += (bounces + 1) // 2
                 wall_hits[other] += bounces // 2
+                wall_impulse[first] += kick * ((bounces + 1) // 2)
+                wall_impulse[other] += kick * (bounces // 2)
 
 
 @numba.njit(cache=True)
