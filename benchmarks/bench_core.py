@@ -70,10 +70,10 @@ def pair_interactions_per_second(n: int, repeats: int) -> dict[str, float]:
     """W2: Coulomb direct sum, N (N - 1) pair terms per evaluation, numba and NumPy."""
     sim = cd.load("charged-gas", n=n, width=200.0, height=200.0)
     p = sim.particles
-    force, energy = np.empty((n, 2)), np.empty(n)
+    force, energy, virial = np.empty((n, 2)), np.empty(n), np.empty(n)
 
     def kernel() -> None:
-        coulomb_direct(p.position, p.charge, 5.0, 0.0, 0.0, 0.0, False, force, energy)
+        coulomb_direct(p.position, p.charge, 5.0, 0.0, 0.0, 0.0, False, force, energy, virial)
 
     kernel()
     start = time.perf_counter()

@@ -50,13 +50,19 @@ class Coulomb:
             raise InputError("forces.coulomb.max_acceleration", f"must be > 0, got {cap!r}")
 
     def compute(
-        self, particles: Particles, box: Box, force: FloatArray, energy: FloatArray
+        self,
+        particles: Particles,
+        box: Box,
+        force: FloatArray,
+        energy: FloatArray,
+        virial: FloatArray,
     ) -> None:
         """Write this force on each particle into ``force`` (N, 2), in N, and each particle's share
-        of the pair energy into ``energy`` (N,), in J (their sum is the potential energy)."""
+        of the pair energy into ``energy`` (N,) and of the pair virial ``sum r_ij . F_ij`` into
+        ``virial`` (N,), both in J (their sums are the totals)."""
         coulomb_direct(
             particles.position, particles.charge, self.k, self.softening**2,
-            box.width, box.height, box.periodic, force, energy,
+            box.width, box.height, box.periodic, force, energy, virial,
         )  # fmt: skip
 
     def limit(self, acceleration: FloatArray) -> None:
@@ -87,9 +93,11 @@ class ForceField:
         self.forces = tuple(forces)
         self._force = np.empty((0, 2))
         self._energy = np.empty(0)
+        self._virial = np.empty(0)
         self._evaluated_at: FloatArray | None = None
         self._acceleration = np.empty((0, 2))
         self._potential = 0.0
+        self._virial_sum = 0.0
 
     @property
     def acceleration(self) -> FloatArray:
@@ -102,7 +110,8 @@ class ForceField:
         return bool(self.forces)
 
     def evaluate(self, particles: Particles, box: Box) -> FloatArray:
-        """Total acceleration (N, 2) in m/s^2 at the current positions; also caches the potential.
+        """Total acceleration (N, 2) in m/s^2 at the current positions; also caches the potential
+        and the virial.
 
         Each force's limiter (if any) applies to that force's own acceleration.
         """
@@ -110,23 +119,37 @@ class ForceField:
         if self._force.shape[0] != n:
             self._force = np.empty((n, 2))
             self._energy = np.empty(n)
+            self._virial = np.empty(n)
             self._acceleration = np.empty((n, 2))
         self._acceleration[...] = 0.0
-        potential = 0.0
+        potential = virial = 0.0
         for force in self.forces:
-            force.compute(particles, box, self._force, self._energy)
+            force.compute(particles, box, self._force, self._energy, self._virial)
             np.divide(self._force, particles.mass[:, None], out=self._force)  # now an acceleration
             force.limit(self._force)
             self._acceleration += self._force
             potential += float(np.sum(self._energy))
+            virial += float(np.sum(self._virial))
         self._potential = potential
+        self._virial_sum = virial
         self._evaluated_at = particles.position.copy()
         return self._acceleration
 
     def potential(self, particles: Particles, box: Box) -> float:
         """Potential energy in J at the current positions (cached from the last evaluation)."""
-        if not self.active:
-            return 0.0
-        if self._evaluated_at is None or not np.array_equal(self._evaluated_at, particles.position):
-            self.evaluate(particles, box)
+        self._refresh(particles, box)
         return self._potential
+
+    def virial(self, particles: Particles, box: Box) -> float:
+        """Pair virial ``sum_{i<j} r_ij . F_ij`` in J at the current positions (of the forces
+        before any acceleration cap; minimum image in a periodic box)."""
+        self._refresh(particles, box)
+        return self._virial_sum
+
+    def _refresh(self, particles: Particles, box: Box) -> None:
+        if not self.active:
+            self._potential = self._virial_sum = 0.0
+        elif self._evaluated_at is None or not np.array_equal(
+            self._evaluated_at, particles.position
+        ):
+            self.evaluate(particles, box)

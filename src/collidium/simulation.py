@@ -204,7 +204,7 @@ class Simulation:
         self.steps += 1
         self._audit()
         for observer in self.observers:
-            if observer.trigger(self.steps):
+            if observer.trigger(self):
                 observer.update(self)
 
     def _audit(self) -> None:
@@ -232,6 +232,17 @@ class Simulation:
         p = self.particles
         kinetic = 0.5 * float(np.sum(p.mass * np.einsum("ij,ij->i", p.velocity, p.velocity)))
         return Energy(kinetic, self._field.potential(p, self.container))
+
+    def temperature(self) -> float:
+        """kT = KE / N in J (2 degrees of freedom per particle, Boltzmann's constant 1); NaN
+        for an empty vessel."""
+        n = self.particles.n
+        return self.energy().kinetic / n if n else float("nan")
+
+    def virial(self) -> float:
+        """Pair virial of the forces, ``sum_{i<j} r_ij . F_ij``, in J at the current positions
+        (0 without forces; collisions add theirs through ``tally.impulse``)."""
+        return self._field.virial(self.particles, self.container)
 
     def momentum(self) -> FloatArray:
         """Total momentum ``sum m v``, shape (2,), in kg m/s."""

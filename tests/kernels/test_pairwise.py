@@ -13,10 +13,11 @@ def _coulomb(position, charge, k=5.0, eps2=0.0, size=None):
     n = len(position)
     force = np.empty((n, 2))
     energy = np.empty(n)
+    virial = np.empty(n)
     periodic = size is not None
     w, h = size if periodic else (0.0, 0.0)
-    coulomb_direct(position, charge, k, eps2, w, h, periodic, force, energy)
-    return force, energy
+    coulomb_direct(position, charge, k, eps2, w, h, periodic, force, energy, virial)
+    return force, energy, virial
 
 
 @pytest.fixture
@@ -30,7 +31,7 @@ def charges(rng):
 @pytest.mark.parametrize("eps2", [0.0, 0.05**2])
 def test_forces_are_minus_the_gradient_of_the_potential(charges, eps2):
     position, charge = charges
-    force, _ = _coulomb(position, charge, eps2=eps2)
+    force, *_ = _coulomb(position, charge, eps2=eps2)
     h = 1e-6
     for i in (0, 7, 21):
         for d in range(2):
@@ -47,22 +48,25 @@ def test_forces_are_minus_the_gradient_of_the_potential(charges, eps2):
 
 def test_forces_sum_to_zero(charges):
     position, charge = charges
-    force, _ = _coulomb(position, charge)
+    force, *_ = _coulomb(position, charge)
     scale = np.abs(force).sum()
     np.testing.assert_allclose(force.sum(axis=0), 0.0, atol=1e-14 * scale)
 
 
 def test_potential_of_two_charges_is_k_q1_q2_over_r():
-    force, energy = _coulomb(np.array([[-2.0, 0.0], [2.0, 0.0]]), np.array([1.0, -1.0]))
+    force, energy, virial = _coulomb(np.array([[-2.0, 0.0], [2.0, 0.0]]), np.array([1.0, -1.0]))
     assert energy.sum() == pytest.approx(-5.0 / 4.0, rel=1e-15)
     assert force[0, 0] == pytest.approx(5.0 / 16.0, rel=1e-15)  # attracted to the right
+    # r_12 . F_12 = (-4) * (5/16) for the attracting pair: equal to U for an inverse-r potential.
+    assert virial.sum() == pytest.approx(-5.0 / 4.0, rel=1e-15)
 
 
 @pytest.mark.parametrize("periodic", [False, True])
 def test_kernel_equals_numpy_twin(charges, periodic):
     position, charge = charges
     size = np.array([16.0, 16.0]) if periodic else None
-    got_force, got_energy = _coulomb(position, charge, eps2=0.01, size=size)
-    want_force, want_energy = reference.coulomb_direct(position, charge, 5.0, 0.01, size)
-    np.testing.assert_allclose(got_force, want_force, rtol=1e-12, atol=1e-13)
-    np.testing.assert_allclose(got_energy, want_energy, rtol=1e-12, atol=1e-13)
+    got_force, got_energy, got_virial = _coulomb(position, charge, eps2=0.01, size=size)
+    want = reference.coulomb_direct(position, charge, 5.0, 0.01, size)
+    np.testing.assert_allclose(got_force, want[0], rtol=1e-12, atol=1e-13)
+    np.testing.assert_allclose(got_energy, want[1], rtol=1e-12, atol=1e-13)
+    np.testing.assert_allclose(got_virial, want[2], rtol=1e-12, atol=1e-13)

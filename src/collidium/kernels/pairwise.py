@@ -48,6 +48,7 @@ def coulomb_direct(
     periodic: bool,
     force: np.ndarray,
     energy: np.ndarray,
+    virial: np.ndarray,
 ) -> None:
     """Coulomb forces and per-particle energies by direct summation, O(N^2), parallel over rows.
 
@@ -69,12 +70,15 @@ def coulomb_direct(
         Output: total force on each particle, N.
     energy : ndarray, shape (N,)
         Output: half the pair energy of each particle with all others, J (sum = total potential).
+    virial : ndarray, shape (N,)
+        Output: half of ``sum_j r_ij . F_ij`` for each particle, J (sum = the pair virial).
     """
     n = position.shape[0]
     for i in numba.prange(n):
         fx = 0.0
         fy = 0.0
         u = 0.0
+        w = 0.0
         qi = charge[i]
         if qi != 0.0:
             xi = position[i, 0]
@@ -92,6 +96,8 @@ def coulomb_direct(
                 fx += f * dx
                 fy += f * dy
                 u += uij
+                w += f * (dx * dx + dy * dy)
         force[i, 0] = fx
         force[i, 1] = fy
         energy[i] = 0.5 * u
+        virial[i] = 0.5 * w

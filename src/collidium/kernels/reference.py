@@ -39,20 +39,22 @@ def coulomb_direct(
     k: float,
     softening2: float,
     size: FloatArray | None = None,
-) -> tuple[FloatArray, FloatArray]:
-    """Coulomb forces (N, 2) and per-particle half pair energies (N,) over all pairs at once.
-
-    ``size`` (the box sides) turns on the minimum image.
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Coulomb forces (N, 2), per-particle half pair energies (N,) and half pair virials
+    ``r_ij . F_ij`` (N,) over all pairs at once. ``size`` (the box sides) turns on the minimum
+    image.
     """
     d = position[:, None, :] - position[None, :, :]
     if size is not None:
         d -= size * np.round(d / size)
-    r2 = np.einsum("ijk,ijk->ij", d, d) + softening2
+    distance2 = np.einsum("ijk,ijk->ij", d, d)
+    r2 = distance2 + softening2
     np.fill_diagonal(r2, np.inf)
     qq = charge[:, None] * charge[None, :]
     inv = 1.0 / np.sqrt(r2)
     force = np.einsum("ij,ijk->ik", k * qq * inv**3, d)
-    return force, 0.5 * np.sum(k * qq * inv, axis=1)
+    virial = 0.5 * np.sum(k * qq * inv**3 * distance2, axis=1)
+    return force, 0.5 * np.sum(k * qq * inv, axis=1), virial
 
 
 def first_overlap(position: FloatArray, radius: FloatArray) -> tuple[int, int]:

@@ -1,6 +1,29 @@
-"""Observers: measurements taken during a run, each fired by a trigger."""
+"""Observers: measurements taken during a run, each fired by a trigger.
 
-from collidium.observers.base import Every, Observer, Trigger
-from collidium.observers.energy import EnergyDrift
+Attach one with ``sim.observers.append(obs)`` (or list it in a scenario file); the run loop calls
+``obs.update(sim)`` after each step on which ``obs.trigger(sim)`` is true. Each measurement can
+also be used on its own, freud-style: ``obs.compute(sim)`` returns the observer, ``reset=False``
+accumulates, ``obs.plot(ax)`` draws it.
+"""
 
-__all__ = ["EnergyDrift", "Every", "Observer", "Trigger"]
+from collidium.observers.base import After, Every, Interval, Measurement, Observer, Trigger
+from collidium.observers.counters import CollisionRate
+from collidium.observers.energy import EnergyDrift, EnergySeries
+from collidium.observers.paths import Tracer
+from collidium.observers.speeds import SpeedHistogram
+from collidium.observers.thermo import Thermo
+
+__all__ = [
+    "After",
+    "CollisionRate",
+    "EnergyDrift",
+    "EnergySeries",
+    "Every",
+    "Interval",
+    "Measurement",
+    "Observer",
+    "SpeedHistogram",
+    "Thermo",
+    "Tracer",
+    "Trigger",
+]

@@ -1,22 +1,39 @@
-"""Triggers and the observer protocol (HOOMD-style: an operation fired by a trigger)."""
+"""Triggers and the observer base class (HOOMD-style: an operation fired by a trigger; freud-style:
+``compute() -> self``, ``reset=False`` accumulates, ``.plot(ax)``)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, Self, runtime_checkable
 
 from collidium.errors import InputError
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
     from collidium.simulation import Simulation
 
-Trigger = Callable[[int], bool]
+#: A trigger is called with the simulation after each step and says whether to fire.
+Trigger = Callable[["Simulation"], bool]
+
+
+def _whole(value: object, field: str, least: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < least:
+        raise InputError(field, f"must be a whole number >= {least}, got {value!r}")
+    return value
+
+
+def _duration(value: object, field: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise InputError(field, f"must be a finite number, got {value!r}")
+    return float(value)
 
 
 @dataclass(frozen=True)
 class Every:
-    """Trigger that fires every ``period`` steps (step 0 excluded).
+    """Fires every ``period`` steps (on steps ``period, 2 period, ...``).
 
     Parameters
     ----------
@@ -27,17 +44,75 @@ class Every:
     period: int = 1
 
     def __post_init__(self) -> None:
-        if isinstance(self.period, bool) or not isinstance(self.period, int) or self.period < 1:
-            raise InputError("trigger.period", f"must be a whole number >= 1, got {self.period!r}")
+        _whole(self.period, "trigger.period", 1)
 
-    def __call__(self, step: int) -> bool:
-        return step % self.period == 0
+    def __call__(self, sim: Simulation) -> bool:
+        return sim.steps % self.period == 0
+
+
+@dataclass(frozen=True)
+class Interval:
+    """Fires on the first step at or past each multiple of ``seconds`` of simulated time.
+
+    Parameters
+    ----------
+    seconds : float
+        Simulated time between firings in s, > 0.
+    """
+
+    seconds: float
+
+    def __post_init__(self) -> None:
+        if _duration(self.seconds, "trigger.interval") <= 0:
+            raise InputError("trigger.interval", f"must be > 0, got {self.seconds!r}")
+
+    def __call__(self, sim: Simulation) -> bool:
+        # A relative slack keeps times that are multiples up to round-off on the right side.
+        slack = 1e-9
+        now = math.floor(sim.time / self.seconds + slack)
+        before = math.floor((sim.time - sim.dt) / self.seconds + slack)
+        return now > before
+
+
+@dataclass(frozen=True)
+class After:
+    """Fires once the simulated time has reached ``time``, whenever ``then`` fires.
+
+    Parameters
+    ----------
+    time : float
+        Start time in s.
+    then : callable, optional
+        Trigger applied from then on (default: every step).
+    """
+
+    time: float
+    then: Trigger = Every(1)
+
+    def __post_init__(self) -> None:
+        _duration(self.time, "trigger.after")
+
+    def __call__(self, sim: Simulation) -> bool:
+        return sim.time >= self.time * (1 - 1e-12) and self.then(sim)
+
+
+def as_trigger(trigger: Trigger | int | None) -> Trigger:
+    """A trigger from a trigger, a whole number of steps (`Every`) or None (every step)."""
+    if trigger is None:
+        return Every(1)
+    if isinstance(trigger, int) and not isinstance(trigger, bool):
+        return Every(trigger)
+    if not callable(trigger):
+        raise InputError(
+            "trigger", f"must be a whole number of steps or a callable, got {trigger!r}"
+        )
+    return trigger
 
 
 @runtime_checkable
 class Observer(Protocol):
-    """What the run loop calls: ``attach`` once before the first step, then ``update`` whenever
-    ``trigger(sim.steps)`` is true after a step."""
+    """What the run loop calls: ``attach`` once before the first step, then ``update`` after each
+    step on which ``trigger(sim)`` is true."""
 
     trigger: Trigger
 
@@ -46,3 +121,56 @@ class Observer(Protocol):
 
     def update(self, sim: Simulation) -> None:
         """Called after a step on which the trigger fires."""
+
+
+class Measurement:
+    """Base of the measuring observers.
+
+    A subclass implements `compute`; `update` (called by the run loop) is ``compute(sim,
+    reset=False)``, so attached to a simulation a measurement accumulates over the run, while a
+    direct ``compute(sim)`` measures the current state afresh.
+
+    Parameters
+    ----------
+    trigger : callable or int, optional
+        When the run loop samples: a trigger, a number of steps, or None for every step.
+    """
+
+    def __init__(self, trigger: Trigger | int | None = None) -> None:
+        self.trigger: Trigger = as_trigger(trigger)
+
+    def attach(self, sim: Simulation) -> None:
+        """Take the first sample when a run starts, unless samples were taken already."""
+        if not self.sampled:
+            self.compute(sim)
+
+    def update(self, sim: Simulation) -> None:
+        """Add a sample (called by the run loop)."""
+        self.compute(sim, reset=False)
+
+    @property
+    def sampled(self) -> bool:
+        """True once at least one sample was taken."""
+        raise NotImplementedError
+
+    def compute(self, sim: Simulation, reset: bool = True) -> Self:
+        """Sample the simulation; ``reset=False`` adds to the samples taken so far."""
+        raise NotImplementedError
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Draw the measurement on ``ax`` (a new figure if None) and return the axes."""
+        raise NotImplementedError
+
+    def summary(self) -> dict[str, Any]:
+        """Plain numbers describing the measurement (for JSON)."""
+        raise NotImplementedError
+
+
+def new_axes(ax: Axes | None) -> Axes:
+    """``ax``, or the axes of a new matplotlib figure."""
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+
+    _, created = plt.subplots()
+    return created

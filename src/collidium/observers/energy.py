@@ -1,43 +1,180 @@
-"""Energy bookkeeping during a run."""
+"""Energy bookkeeping: the series the seed plots (Fig. 2) and the drift of the total."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Self
 
-from collidium.observers.base import Every, Trigger
+import numpy as np
+
+from collidium.observers.base import Measurement, Trigger, new_axes
+from collidium.state import FloatArray
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
     from collidium.simulation import Simulation
 
+#: The seed's colours (Fig. 2): kinetic blue, total speed green, potential pink, total black.
+SEED_COLOURS = {"kinetic": "tab:blue", "total_speed": "tab:green", "potential": "tab:pink",
+                "total": "black"}  # fmt: skip
 
-class EnergyDrift:
-    """Largest relative change of the total energy seen during a run.
+_COLUMNS = ("time", "kinetic", "potential", "total_speed", "px", "py")
+
+
+class EnergySeries(Measurement):
+    """Kinetic, potential and total energy, total speed and momentum over time.
 
     Parameters
     ----------
-    trigger : callable, optional
+    trigger : callable or int, optional
+        When to sample (default every step).
+
+    Attributes
+    ----------
+    time, kinetic, potential, total, total_speed : ndarray, shape (K,)
+        One value per sample: s, J, J, J, m/s.
+    momentum : ndarray, shape (K, 2)
+        Total momentum in kg m/s.
+    """
+
+    def __init__(self, trigger: Trigger | int | None = None) -> None:
+        super().__init__(trigger)
+        self._rows: list[tuple[float, ...]] = []
+
+    @property
+    def sampled(self) -> bool:
+        """True once a sample was taken."""
+        return bool(self._rows)
+
+    def compute(self, sim: Simulation, reset: bool = True) -> Self:
+        """Sample the energies of ``sim``; ``reset=False`` appends to the series."""
+        if reset:
+            self._rows = []
+        e = sim.energy()
+        px, py = sim.momentum()
+        self._rows.append((sim.time, e.kinetic, e.potential, sim.total_speed(), px, py))
+        return self
+
+    def _column(self, name: str) -> FloatArray:
+        table = np.asarray(self._rows, dtype=float).reshape(-1, len(_COLUMNS))
+        return table[:, _COLUMNS.index(name)]
+
+    @property
+    def time(self) -> FloatArray:
+        """Sample times in s."""
+        return self._column("time")
+
+    @property
+    def kinetic(self) -> FloatArray:
+        """Kinetic energy in J."""
+        return self._column("kinetic")
+
+    @property
+    def potential(self) -> FloatArray:
+        """Potential energy in J."""
+        return self._column("potential")
+
+    @property
+    def total(self) -> FloatArray:
+        """Kinetic plus potential energy in J."""
+        return self.kinetic + self.potential
+
+    @property
+    def total_speed(self) -> FloatArray:
+        """Sum of the speeds in m/s."""
+        return self._column("total_speed")
+
+    @property
+    def momentum(self) -> FloatArray:
+        """Total momentum (K, 2) in kg m/s."""
+        return np.stack([self._column("px"), self._column("py")], axis=1)
+
+    @property
+    def max_rel_drift(self) -> float:
+        """Largest ``|E(t) - E(t0)| / |E(t0)|`` over the samples (0 with fewer than two)."""
+        total = self.total
+        if total.size == 0:
+            return 0.0
+        return float(np.max(np.abs(total - total[0])) / max(abs(total[0]), 1e-300))
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Energies against time in the seed's colours; total speed on a second axis (green)."""
+        return plot_energy(ax, self.time, self.kinetic, self.potential, self.total_speed)
+
+    def summary(self) -> dict[str, Any]:
+        """Last sample and the largest relative drift of the total energy."""
+        if not self._rows:
+            return {}
+        last = dict(zip(_COLUMNS, self._rows[-1]))
+        return {
+            "kinetic": last["kinetic"],
+            "potential": last["potential"],
+            "total": last["kinetic"] + last["potential"],
+            "initial_total": float(self.total[0]),
+            "max_rel_drift": self.max_rel_drift,
+        }
+
+
+def plot_energy(
+    ax: Axes | None,
+    time: FloatArray,
+    kinetic: FloatArray,
+    potential: FloatArray,
+    total_speed: FloatArray,
+) -> Axes:
+    """The seed's energy plot: kinetic (blue), potential (pink) and total (black) energy in J
+    against time in s, and the total speed (green, m/s) on a second axis. Returns ``ax``."""
+    ax = new_axes(ax)
+    curves = {"kinetic": kinetic, "potential": potential, "total": kinetic + potential}
+    for name, values in curves.items():
+        ax.plot(time, values, color=SEED_COLOURS[name], label=name)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("energy (J)")
+    speed_axis = ax.twinx()
+    speed_axis.plot(time, total_speed, color=SEED_COLOURS["total_speed"], label="total speed")
+    speed_axis.set_ylabel("total speed (m/s)", color=SEED_COLOURS["total_speed"])
+    lines = ax.get_lines() + speed_axis.get_lines()
+    ax.legend(lines, [line.get_label() for line in lines], loc="lower right", fontsize="small")
+    return ax
+
+
+class EnergyDrift(Measurement):
+    """Largest relative change of the total energy during a run, without storing a series.
+
+    Parameters
+    ----------
+    trigger : callable or int, optional
         When to sample (default every step).
 
     Attributes
     ----------
     initial_total : float
-        Total energy in J when attached.
+        Total energy in J at the first sample.
     max_rel_drift : float
-        ``max |E(t) - E(0)| / |E(0)|`` over the samples (relative to ``max(|E(0)|, tiny)``).
+        ``max |E(t) - E(0)| / |E(0)|`` over the samples.
     """
 
-    def __init__(self, trigger: Trigger | None = None) -> None:
-        self.trigger: Trigger = trigger or Every(1)
+    def __init__(self, trigger: Trigger | int | None = None) -> None:
+        super().__init__(trigger)
         self.initial_total = float("nan")
         self.max_rel_drift = 0.0
 
-    def attach(self, sim: Simulation) -> None:
-        """Record the starting total energy."""
-        self.initial_total = sim.energy().total
-        self.max_rel_drift = 0.0
+    @property
+    def sampled(self) -> bool:
+        """True once the starting energy is known."""
+        return not np.isnan(self.initial_total)
 
-    def update(self, sim: Simulation) -> None:
-        """Fold the current total energy into the running maximum."""
-        scale = max(abs(self.initial_total), 1e-300)
-        drift = abs(sim.energy().total - self.initial_total) / scale
-        self.max_rel_drift = max(self.max_rel_drift, drift)
+    def compute(self, sim: Simulation, reset: bool = True) -> Self:
+        """Start afresh from the current energy, or (``reset=False``) fold it into the maximum."""
+        total = sim.energy().total
+        if reset or not self.sampled:
+            self.initial_total = total
+            self.max_rel_drift = 0.0
+        else:
+            drift = abs(total - self.initial_total) / max(abs(self.initial_total), 1e-300)
+            self.max_rel_drift = max(self.max_rel_drift, drift)
+        return self
+
+    def summary(self) -> dict[str, Any]:
+        """Initial total energy and largest relative drift."""
+        return {"initial_total": self.initial_total, "max_rel_drift": self.max_rel_drift}

@@ -1,0 +1,340 @@
+"""GSD trajectories (DESIGN.md section 5) and extended-XYZ export.
+
+A frame holds the HOOMD schema that OVITO, MDAnalysis and freud read: a 2D box
+``[Lx, Ly, 0, 0, 0, 0]`` centred on the origin, positions (N, 3) with z = 0, velocities, masses,
+charges and diameters, a particle type per sign of the charge, and the observables under
+``log/`` (`LOG_KEYS`). Positions and velocities are stored in single precision, as the schema
+does by default; checkpoints (`collidium.io.checkpoint`) keep the exact state.
+"""
+
+from __future__ import annotations
+
+import time as clock
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from collidium.errors import InputError
+from collidium.observers.base import Trigger, as_trigger
+from collidium.state import FloatArray
+
+if TYPE_CHECKING:
+    import gsd.hoomd
+
+    from collidium.simulation import Simulation
+
+#: Particle types by the sign of the charge (OVITO colours by type).
+TYPES = ("neutral", "positive", "negative")
+
+#: What each frame logs, ``log/<key>``: name -> description.
+LOG_KEYS = {
+    "collidium/time": "simulated time, s",
+    "collidium/dt": "time step, s",
+    "collidium/periodic": "1 for a periodic box, 0 for reflecting walls",
+    "energy/kinetic": "kinetic energy, J",
+    "energy/potential": "potential energy, J",
+    "energy/total": "total energy, J",
+    "energy/total_speed": "sum of the speeds, m/s",
+    "momentum": "total momentum (px, py), kg m/s",
+    "temperature": "kT = KE / N, J",
+    "collisions/pair": "pair collisions since the start",
+    "collisions/walls": "hits on the left, right, bottom, top wall since the start",
+    "impulse/virial": "collision virial sum r_ij . dp_i since the start, kg m^2/s",
+    "impulse/walls": "momentum received by the left, right, bottom, top wall, kg m/s",
+    "virial/forces": "pair virial of the forces now, J",
+}
+
+
+def type_ids(charge: FloatArray) -> np.ndarray:
+    """Index into `TYPES` for each charge: 0 neutral, 1 positive, 2 negative."""
+    return np.where(charge > 0, 1, np.where(charge < 0, 2, 0)).astype(np.uint32)
+
+
+def frame_of(sim: Simulation) -> gsd.hoomd.Frame:
+    """The simulation's current state as a GSD frame."""
+    import gsd.hoomd
+
+    p = sim.particles
+    box = sim.container
+    frame = gsd.hoomd.Frame()
+    frame.configuration.step = sim.steps
+    frame.configuration.dimensions = 2
+    frame.configuration.box = [box.width, box.height, 0.0, 0.0, 0.0, 0.0]
+    frame.particles.N = p.n
+    frame.particles.types = list(TYPES)
+    frame.particles.typeid = type_ids(p.charge)
+    frame.particles.position = np.column_stack([p.position, np.zeros(p.n)]).astype(np.float32)
+    frame.particles.velocity = np.column_stack([p.velocity, np.zeros(p.n)]).astype(np.float32)
+    frame.particles.mass = p.mass.astype(np.float32)
+    frame.particles.charge = p.charge.astype(np.float32)
+    frame.particles.diameter = (2.0 * p.radius).astype(np.float32)
+    if box.periodic:
+        frame.particles.image = np.column_stack([p.image, np.zeros(p.n)]).astype(np.int32)
+    energy = sim.energy()
+    counts, impulse = sim.tally.counts, sim.tally.impulse
+    values: dict[str, Any] = {
+        "collidium/time": sim.time,
+        "collidium/dt": sim.dt,
+        "collidium/periodic": int(box.periodic),
+        "energy/kinetic": energy.kinetic,
+        "energy/potential": energy.potential,
+        "energy/total": energy.total,
+        "energy/total_speed": sim.total_speed(),
+        "momentum": sim.momentum(),
+        "temperature": sim.temperature(),
+        "collisions/pair": counts[0],
+        "collisions/walls": counts[1:],
+        "impulse/virial": impulse[0],
+        "impulse/walls": impulse[1:],
+        "virial/forces": sim.virial(),
+    }
+    frame.log = {key: np.atleast_1d(np.asarray(value)) for key, value in values.items()}
+    return frame
+
+
+class GSDWriter:
+    """Observer that appends a frame to a GSD file whenever its trigger fires.
+
+    Parameters
+    ----------
+    path : str or Path
+        File to write (replaced, unless ``append``).
+    trigger : callable or int, optional
+        When to write (default every step). The state when the run starts is written too.
+    flush_seconds : float
+        Frames are flushed to disk at most this many wall-clock seconds apart (and when the
+        writer is closed); 0 flushes every frame. A killed run keeps every flushed frame.
+    append : bool
+        Add to an existing file instead of replacing it (used when a run resumes).
+    """
+
+    def __init__(
+        self,
+        path: str | Path,
+        trigger: Trigger | int | None = None,
+        flush_seconds: float = 1.0,
+        append: bool = False,
+    ) -> None:
+        self.path = Path(path)
+        self.trigger = as_trigger(trigger)
+        if not flush_seconds >= 0:
+            raise InputError("flush_seconds", f"must be >= 0, got {flush_seconds!r}")
+        self.flush_seconds = float(flush_seconds)
+        self.append = append
+        self._file: gsd.hoomd.HOOMDTrajectory | None = None
+        self._last_flush = 0.0
+        self._last_step = -1
+        self.frames_written = 0
+
+    def attach(self, sim: Simulation) -> None:
+        """Open the file and write the current state as the first frame."""
+        import gsd.hoomd
+
+        if self._file is None:
+            try:
+                self._file = gsd.hoomd.open(self.path, "r+" if self.append else "w")
+            except (OSError, RuntimeError) as exc:
+                raise InputError(str(self.path), f"cannot write a GSD file: {exc}") from None
+            self._last_flush = clock.monotonic()
+            if self.append and len(self._file):
+                self._last_step = int(self._file[-1].configuration.step)
+        self.update(sim)
+
+    def update(self, sim: Simulation) -> None:
+        """Append the current state (once per step) and flush when due."""
+        if self._file is None or sim.steps == self._last_step:
+            return
+        self._file.append(frame_of(sim))
+        self._last_step = sim.steps
+        self.frames_written += 1
+        now = clock.monotonic()
+        if now - self._last_flush >= self.flush_seconds:
+            self._file.flush()
+            self._last_flush = now
+
+    def close(self) -> None:
+        """Flush and close the file (the writer can be attached again to reopen it)."""
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+            self.append = True  # reopening continues the same file
+
+    def __enter__(self) -> GSDWriter:
+        return self
+
+    def __exit__(self, *_: object) -> None:
+        self.close()
+
+
+@dataclass
+class Trajectory:
+    """Frames read back from a GSD file (or recorded in memory), as float64 arrays.
+
+    Attributes
+    ----------
+    width, height : float
+        Box sides in m; the box is centred on the origin.
+    periodic : bool
+        Periodic box (else reflecting walls).
+    step : ndarray of int64, shape (K,)
+        Step of each frame.
+    time : ndarray, shape (K,)
+        Simulated time of each frame in s.
+    position, velocity : ndarray, shape (K, N, 2)
+        Centres (m) and velocities (m/s).
+    mass, radius, charge : ndarray, shape (N,)
+        From the first frame (kg, m, C).
+    log : dict of str to ndarray
+        Each ``log/`` entry (without the prefix) stacked over frames, shape (K, ...).
+    """
+
+    width: float
+    height: float
+    periodic: bool
+    step: np.ndarray
+    time: FloatArray
+    position: FloatArray
+    velocity: FloatArray
+    mass: FloatArray
+    radius: FloatArray
+    charge: FloatArray
+    log: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def frames(self) -> int:
+        """Number of frames."""
+        return int(self.step.shape[0])
+
+    @property
+    def n(self) -> int:
+        """Number of particles."""
+        return int(self.mass.shape[0])
+
+
+def _open_for_reading(path: Path) -> gsd.hoomd.HOOMDTrajectory:
+    import gsd.hoomd
+
+    if not path.is_file():
+        raise InputError(str(path), "no such file")
+    try:
+        return gsd.hoomd.open(path, "r")
+    except Exception as exc:  # gsd raises RuntimeError, OSError or ValueError on bad files
+        raise InputError(str(path), f"not a readable GSD trajectory ({exc})") from None
+
+
+def iter_frames(path: str | Path) -> Iterator[gsd.hoomd.Frame]:
+    """Frames of a GSD file, one at a time; a damaged frame gives an `InputError`."""
+    path = Path(path)
+    with _open_for_reading(path) as trajectory:
+        for k in range(len(trajectory)):
+            try:
+                frame = trajectory[k]
+            except Exception as exc:
+                raise InputError(str(path), f"frame {k} cannot be read ({exc})") from None
+            yield frame
+
+
+def read_trajectory(path: str | Path) -> Trajectory:
+    """All frames of a GSD file written by collidium (or any 2D HOOMD-schema file).
+
+    Raises
+    ------
+    InputError
+        If the file is missing, is not GSD, is damaged, has no frames or is not 2D.
+    """
+    path = Path(path)
+    frames = list(iter_frames(path))
+    if not frames:
+        raise InputError(str(path), "the trajectory has no frames")
+    first = frames[0]
+    if first.configuration.dimensions != 2:
+        raise InputError(str(path), f"expected a 2D box, found {first.configuration.dimensions}D")
+    n = int(first.particles.N)
+    if any(int(f.particles.N) != n for f in frames):
+        raise InputError(str(path), "the number of particles changes between frames")
+    log = {
+        key: np.stack([np.asarray(f.log[key]) for f in frames])
+        for key in first.log
+        if all(key in f.log for f in frames)
+    }
+    step = np.array([int(f.configuration.step) for f in frames], dtype=np.int64)
+    time = log["collidium/time"][:, 0] if "collidium/time" in log else step.astype(float)
+    periodic = bool(log["collidium/periodic"][0, 0]) if "collidium/periodic" in log else True
+    return Trajectory(
+        width=float(first.configuration.box[0]),
+        height=float(first.configuration.box[1]),
+        periodic=periodic,
+        step=step,
+        time=np.asarray(time, dtype=float),
+        position=np.stack([f.particles.position[:, :2] for f in frames]).astype(float),
+        velocity=np.stack([f.particles.velocity[:, :2] for f in frames]).astype(float),
+        mass=np.asarray(first.particles.mass, dtype=float),
+        radius=0.5 * np.asarray(first.particles.diameter, dtype=float),
+        charge=np.asarray(first.particles.charge, dtype=float),
+        log=log,
+    )
+
+
+def keep_frames_through(path: str | Path, step: int) -> int:
+    """Rewrite a GSD file keeping only the frames up to ``step`` (a resumed run continues from
+    there); returns how many frames remain. The file is replaced atomically."""
+    import gsd.hoomd
+
+    path = Path(path)
+    kept = [f for f in iter_frames(path) if int(f.configuration.step) <= step]
+    temporary = path.with_name(f".{path.name}.resume.tmp")
+    with gsd.hoomd.open(temporary, "w") as out:
+        out.extend(kept)
+    temporary.replace(path)
+    return len(kept)
+
+
+def write_xyz(trajectory: Trajectory, path: str | Path) -> None:
+    """Write an extended-XYZ file (one block per frame; OVITO and ASE read it).
+
+    Each block: the particle count, a comment line with ``Lattice``, ``Origin``, ``Properties``,
+    ``Time`` and ``pbc``, then one line per particle: type, x, y, z, vx, vy, vz, mass, radius,
+    charge.
+    """
+    w, h = trajectory.width, trajectory.height
+    pbc = "T T F" if trajectory.periodic else "F F F"
+    names = np.array(TYPES)[type_ids(trajectory.charge)]
+    constant = np.column_stack([trajectory.mass, trajectory.radius, trajectory.charge])
+    lines: list[str] = []
+    for k in range(trajectory.frames):
+        lines.append(str(trajectory.n))
+        lines.append(
+            f'Lattice="{w!r} 0 0 0 {h!r} 0 0 0 1" Origin="{-w / 2!r} {-h / 2!r} -0.5" '
+            "Properties=species:S:1:pos:R:3:velo:R:3:mass:R:1:radius:R:1:charge:R:1 "
+            f'Time={trajectory.time[k]!r} Step={int(trajectory.step[k])} pbc="{pbc}"'
+        )
+        x, v = trajectory.position[k], trajectory.velocity[k]
+        for i in range(trajectory.n):
+            m, r, q = constant[i]
+            lines.append(
+                f"{names[i]} {x[i, 0]!r} {x[i, 1]!r} 0.0 {v[i, 0]!r} {v[i, 1]!r} 0.0 "
+                f"{m!r} {r!r} {q!r}"
+            )
+    Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def describe(path: str | Path) -> dict[str, Any]:
+    """What a GSD file holds: frames, particles, box, steps, times and log entries."""
+    path = Path(path)
+    trajectory = read_trajectory(path)
+    return {
+        "file": str(path),
+        "format": "gsd",
+        "bytes": path.stat().st_size,
+        "frames": trajectory.frames,
+        "n": trajectory.n,
+        "box": [trajectory.width, trajectory.height],
+        "boundary": "periodic" if trajectory.periodic else "reflecting",
+        "steps": [int(trajectory.step[0]), int(trajectory.step[-1])],
+        "time": [float(trajectory.time[0]), float(trajectory.time[-1])],
+        "types": {t: int(np.sum(type_ids(trajectory.charge) == k)) for k, t in enumerate(TYPES)},
+        "log": sorted(trajectory.log),
+    }

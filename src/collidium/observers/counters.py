@@ -1,0 +1,104 @@
+"""Collision counts over time: collision rate, mean free time and mean free path."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any, Self
+
+import numpy as np
+
+from collidium.observers.base import Measurement, Trigger, new_axes
+from collidium.observers.thermo import WALLS
+from collidium.state import FloatArray
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from collidium.simulation import Simulation
+
+
+class CollisionRate(Measurement):
+    """Pair collisions and wall hits (per wall) counted between the first and the last sample.
+
+    Parameters
+    ----------
+    trigger : callable or int, optional
+        When to sample (default every step); the counts are exact whatever it is.
+    """
+
+    def __init__(self, trigger: Trigger | int | None = None) -> None:
+        super().__init__(trigger)
+        self._time: list[float] = []
+        self._counts: list[np.ndarray] = []
+        self._mean_speed: list[float] = []
+
+    @property
+    def sampled(self) -> bool:
+        """True once a sample was taken."""
+        return bool(self._time)
+
+    def compute(self, sim: Simulation, reset: bool = True) -> Self:
+        """Sample the counters; ``reset=False`` extends the window to now."""
+        if reset:
+            self._time, self._counts, self._mean_speed = [], [], []
+            self.n = sim.particles.n
+        self._time.append(sim.time)
+        self._counts.append(sim.tally.counts.copy())
+        self._mean_speed.append(sim.total_speed() / max(sim.particles.n, 1))
+        return self
+
+    @property
+    def time(self) -> FloatArray:
+        """Sample times in s."""
+        return np.asarray(self._time)
+
+    @property
+    def pair_collisions(self) -> FloatArray:
+        """Pair collisions counted since the first sample, at each sample."""
+        counts = np.asarray(self._counts)
+        return (counts[:, 0] - counts[0, 0]) if counts.size else np.empty(0)
+
+    def _gained(self) -> tuple[np.ndarray, float]:
+        if len(self._time) < 2:
+            return np.zeros(5, dtype=np.int64), 0.0
+        return self._counts[-1] - self._counts[0], self._time[-1] - self._time[0]
+
+    @property
+    def rate(self) -> float:
+        """Pair collisions per second."""
+        gained, duration = self._gained()
+        return float(gained[0] / duration) if duration > 0 else float("nan")
+
+    @property
+    def wall_rates(self) -> dict[str, float]:
+        """Hits per second on each wall."""
+        gained, duration = self._gained()
+        return {w: float(gained[1 + k] / duration) if duration > 0 else float("nan")
+                for k, w in enumerate(WALLS)}  # fmt: skip
+
+    @property
+    def mean_free_time(self) -> float:
+        """Mean time between a particle's collisions with others, ``N t / (2 collisions)``, in s."""
+        gained, duration = self._gained()
+        return float(self.n * duration / (2 * gained[0])) if gained[0] > 0 else float("inf")
+
+    @property
+    def mean_free_path(self) -> float:
+        """Mean speed times mean free time, in m."""
+        return float(np.mean(self._mean_speed)) * self.mean_free_time
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Cumulative pair collisions against time."""
+        ax = new_axes(ax)
+        ax.plot(self.time, self.pair_collisions, color="tab:purple")
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("pair collisions")
+        return ax
+
+    def summary(self) -> dict[str, Any]:
+        """Rates, mean free time and path."""
+        return {
+            "rate": self.rate,
+            "wall_rates": self.wall_rates,
+            "mean_free_time": self.mean_free_time,
+            "mean_free_path": self.mean_free_path,
+        }

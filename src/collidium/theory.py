@@ -1,0 +1,70 @@
+"""Results from theory that measurements are compared with: the 2D Maxwell-Boltzmann speed
+distribution, the ideal gas and the hard-disk equation of state. Boltzmann's constant is 1
+(temperatures kT in J)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy import stats
+
+from collidium.errors import InputError
+from collidium.state import FloatArray
+
+
+class MaxwellBoltzmann2D:
+    """Speed distribution of a 2D gas in equilibrium at temperature kT.
+
+    For one mass it is a Rayleigh distribution of scale ``sqrt(kT / m)``,
+    ``f(v) = (m v / kT) exp(-m v^2 / (2 kT))``; for several masses the mixture of those, weighted
+    by the number of particles of each mass.
+
+    Parameters
+    ----------
+    kT : float
+        Temperature in J (> 0).
+    mass : array_like
+        Mass of each particle in kg (shape (N,)), or a single mass.
+    """
+
+    def __init__(self, kT: float, mass: ArrayLike) -> None:
+        if not np.isfinite(kT) or kT <= 0:
+            raise InputError("temperature", f"must be a finite number > 0, got {kT!r}")
+        masses, counts = np.unique(np.atleast_1d(np.asarray(mass, dtype=float)), return_counts=True)
+        self.kT = float(kT)
+        self.masses = masses
+        self.weights = counts / counts.sum()
+        self.components = [stats.rayleigh(scale=np.sqrt(kT / m)) for m in masses]
+
+    def pdf(self, speed: ArrayLike) -> FloatArray:
+        """Probability density at ``speed`` (m/s), in s/m."""
+        return np.asarray(sum(w * c.pdf(speed) for w, c in zip(self.weights, self.components)))
+
+    def cdf(self, speed: ArrayLike) -> FloatArray:
+        """Probability of a speed below ``speed`` (m/s)."""
+        return np.asarray(sum(w * c.cdf(speed) for w, c in zip(self.weights, self.components)))
+
+    def mean(self) -> float:
+        """Mean speed in m/s."""
+        return float(sum(w * c.mean() for w, c in zip(self.weights, self.components)))
+
+    def bin_probabilities(self, edges: ArrayLike) -> FloatArray:
+        """Probability of each bin between consecutive ``edges`` (m/s)."""
+        return np.diff(self.cdf(edges))
+
+
+def ideal_gas_pressure(n: int, kT: float, area: float) -> float:
+    """Pressure ``N kT / A`` of an ideal 2D gas in N/m, for N particles in area A (m^2)."""
+    return n * kT / area
+
+
+def hard_disk_compressibility(packing: float) -> float:
+    """Compressibility factor ``Z = P A / (N kT)`` of the hard-disk fluid (Henderson 1975).
+
+    ``Z = (1 + eta^2 / 8) / (1 - eta)^2`` at packing fraction eta, in the fluid (eta below about
+    0.69, where the fluid branch ends). Against the ten-term virial series it differs by under
+    0.2% up to eta = 0.4.
+    """
+    if not 0 <= packing < 0.69:
+        raise InputError("packing", f"the fluid branch needs 0 <= eta < 0.69, got {packing}")
+    return (1 + packing**2 / 8) / (1 - packing) ** 2
