@@ -11,7 +11,7 @@ from collidium.errors import InputError, SimulationError
 from collidium.forces import Coulomb
 from collidium.loading import load
 from collidium.presets import presets
-from collidium.simulation import Counters, Energy, Simulation
+from collidium.simulation import Counters, Energy, Simulation, restore
 from collidium.state import Particles
 
 __all__ = [
@@ -26,5 +26,6 @@ __all__ = [
     "load",
     "observers",
     "presets",
+    "restore",
 ]
 __version__ = "0.1.0"

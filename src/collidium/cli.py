@@ -1,4 +1,4 @@
-"""The ``collidium`` command line: list presets, run a scenario, export a preset as TOML.
+"""The ``collidium`` command line: presets, run, resume, export, inspect, convert, render.
 
 Bad input of any kind prints one line ``error: <field>: <reason>`` on stderr and exits with
 status 2 (no traceback, nothing half-written); a run that goes wrong exits with status 1.
@@ -75,26 +75,150 @@ def run_command(
     dt: Annotated[float | None, typer.Option("--dt", help="Time step in s.")] = None,
     seed: Annotated[int | None, typer.Option("--seed", help="Random seed.")] = None,
     overrides: SetOption = None,
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", help="Write a trajectory: .gsd (OVITO, MDAnalysis, freud) or .xyz."),
+    ] = None,
+    every: Annotated[
+        int | None, typer.Option("--every", help="Steps between frames (default: 0.1 s).")
+    ] = None,
+    checkpoint: Annotated[
+        Path | None,
+        typer.Option("--checkpoint", help="Checkpoint file, written at the end (and see below)."),
+    ] = None,
+    checkpoint_every: Annotated[
+        int | None,
+        typer.Option("--checkpoint-every", help="Also write the checkpoint every this many steps."),
+    ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Run a preset or scenario file and print a summary."""
     from collidium.loading import load_scenario
-    from collidium.observers import EnergyDrift
+    from collidium.runner import Job, execute
+    from collidium.simulation import step_count
 
     if time is not None and steps is not None:
         raise InputError("--time", "give --time or --steps, not both")
     values = parse_settings(overrides or [])
     values |= {k: v for k, v in (("dt", dt), ("seed", seed)) if v is not None}
     spec = load_scenario(scenario, **values)
-    sim = spec.build()
-    drift = EnergyDrift()
-    sim.observers.append(drift)
     duration = spec.run.time if time is None and steps is None else time
-    progress = not as_json and sys.stderr.isatty()
-    start = clock.perf_counter()
-    sim.run(time=duration, steps=steps, progress=progress)
-    wall = clock.perf_counter() - start
-    summary = run_summary(sim, drift, wall)
+    count = step_count(duration, steps, spec.run.dt)
+    frame_period = every if every is not None else max(1, round(0.1 / spec.run.dt))
+    job = Job(
+        end_step=count, out=None if out is None else str(out), every=frame_period,
+        checkpoint=None if checkpoint is None else str(checkpoint),
+        checkpoint_every=checkpoint_every,
+    )  # fmt: skip
+    sim = spec.build()
+    _report(execute(sim, job, progress=not as_json and sys.stderr.isatty()), as_json)
+
+
+@app.command("resume")
+def resume_command(
+    checkpoint: Annotated[Path, typer.Argument(help="Checkpoint written by run --checkpoint.")],
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Finish an interrupted run from its checkpoint (bitwise the same as never stopping)."""
+    from collidium.runner import execute, resume
+
+    sim, job = resume(checkpoint)
+    _report(execute(sim, job, progress=not as_json and sys.stderr.isatty()), as_json)
+
+
+@app.command("inspect")
+def inspect_command(
+    path: Annotated[Path, typer.Argument(help="A .gsd trajectory or a checkpoint.")],
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Say what a trajectory or checkpoint file holds."""
+    from collidium.io import describe_file
+
+    facts = describe_file(path)
+    if as_json:
+        typer.echo(json.dumps(facts, indent=2))
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title=f"collidium inspect: {path}", show_header=False)
+    table.add_column("field")
+    table.add_column("value")
+    for key, value in facts.items():
+        table.add_row(key, value if isinstance(value, str) else json.dumps(value))
+    Console().print(table)
+
+
+@app.command("convert")
+def convert_command(
+    source: Annotated[Path, typer.Argument(help="A .gsd trajectory.")],
+    target: Annotated[Path, typer.Argument(help="The extended-XYZ file to write (.xyz).")],
+) -> None:
+    """Export a GSD trajectory as extended XYZ."""
+    from collidium.io.trajectory import read_trajectory, write_xyz
+
+    if target.suffix != ".xyz":
+        raise InputError("target", f"must end in .xyz, got {target}")
+    write_xyz(read_trajectory(source), target)
+
+
+@app.command("render")
+def render_command(
+    source: Annotated[str, typer.Argument(help="A .gsd trajectory, a preset or a .toml file.")],
+    plots: Annotated[
+        Path | None, typer.Option("--plots", help="Folder for energy.png and speeds.png.")
+    ] = None,
+    movie: Annotated[
+        Path | None, typer.Option("--movie", help="Movie file: .mp4 (needs [movie]) or .gif.")
+    ] = None,
+    time: Annotated[
+        float | None, typer.Option("--time", help="Duration in s when running a scenario.")
+    ] = None,
+    every: Annotated[
+        int | None, typer.Option("--every", help="Steps between frames when running a scenario.")
+    ] = None,
+    fps: Annotated[int, typer.Option("--fps", help="Movie frames per second.")] = 20,
+    overrides: SetOption = None,
+) -> None:
+    """Draw the seed's plots and movie from a trajectory (or from running a scenario)."""
+    from collidium import render
+
+    if plots is None and movie is None:
+        raise InputError("--plots", "give --plots DIR and/or --movie FILE")
+    if fps < 1:
+        raise InputError("--fps", f"must be >= 1, got {fps}")
+    trajectory = _trajectory_of(source, time, every, parse_settings(overrides or []))
+    show = sys.stderr.isatty()
+    if plots is not None:
+        for path in render.write_plots(trajectory, plots):
+            typer.echo(str(path))
+    if movie is not None:
+        typer.echo(str(render.write_movie(trajectory, movie, fps=fps, progress=show)))
+
+
+def _trajectory_of(
+    source: str, time: float | None, every: int | None, overrides: dict[str, Any]
+) -> Any:
+    """The trajectory in a .gsd file, or recorded by running a preset or scenario."""
+    from collidium.io.trajectory import read_trajectory
+
+    if source.endswith(".gsd"):
+        return read_trajectory(source)
+    from collidium.loading import load_scenario
+    from collidium.runner import Job, execute
+    from collidium.simulation import step_count
+
+    spec = load_scenario(source, **overrides)
+    count = step_count(spec.run.time if time is None else time, None, spec.run.dt)
+    with tempfile.TemporaryDirectory() as folder:
+        recording = Path(folder) / "run.gsd"
+        period = every if every is not None else max(1, count // 200)
+        execute(spec.build(), Job(end_step=count, out=str(recording), every=period),
+                progress=sys.stderr.isatty())  # fmt: skip
+        return read_trajectory(recording)
+
+
+def _report(summary: dict[str, Any], as_json: bool) -> None:
     if as_json:
         typer.echo(json.dumps(summary))
     else:
@@ -166,36 +290,12 @@ def _umask() -> int:
     return mask
 
 
-def run_summary(sim: Any, drift: Any, wall_seconds: float) -> dict[str, Any]:
-    """Plain numbers describing a finished run (the ``--json`` object).
-
-    Parameters
-    ----------
-    sim : Simulation
-        The simulation after its run.
-    drift : EnergyDrift
-        The observer attached for the run.
-    wall_seconds : float
-        Elapsed real time of the run in s.
-    """
-    summary: dict[str, Any] = sim.summary()
-    summary["dt"] = float(sim.dt)
-    summary["wall_seconds"] = wall_seconds
-    summary["energy"]["initial_total"] = _finite_or_none(drift.initial_total)
-    summary["energy"]["max_rel_drift"] = _finite_or_none(drift.max_rel_drift)
-    return summary
-
-
-def _finite_or_none(value: float) -> float | None:
-    """JSON has no NaN: a non-finite number becomes null."""
-    return float(value) if math.isfinite(value) else None
-
-
 def _print_summary(summary: dict[str, Any]) -> None:
     from rich.console import Console
     from rich.table import Table
 
     energy = summary["energy"]
+    pressure = summary["pressure"]
     drift = energy["max_rel_drift"]
     rows = [
         ("particles", f"{summary['n']}"),
@@ -208,6 +308,11 @@ def _print_summary(summary: dict[str, Any]) -> None:
         ("momentum", "({:.6g}, {:.6g}) kg m/s".format(*summary["momentum"])),
         ("pair collisions", f"{summary['collisions']['pair']}"),
         ("wall collisions", f"{summary['collisions']['wall']}"),
+        ("collision rate", _number(summary["collisions"]["rate"], "/s")),
+        ("temperature kT", _number(summary["temperature"], "J")),
+        ("wall pressure", _number(pressure["wall"], "N/m", pressure["wall_error"])),
+        ("virial pressure", _number(pressure["virial"], "N/m", pressure["virial_error"])),
+        ("Maxwell-Boltzmann KS p-value", _number(summary["ks_pvalue"], "")),
         ("escaped", f"{summary['escaped']}"),
     ]
     table = Table(title=f"collidium run: {summary['scenario']}", show_header=False)
@@ -216,6 +321,13 @@ def _print_summary(summary: dict[str, Any]) -> None:
     for row in rows:
         table.add_row(*row)
     Console().print(table)
+
+
+def _number(value: float | None, unit: str, error: float | None = None) -> str:
+    if value is None:
+        return "n/a"
+    spread = f" ± {error:.2g}" if error is not None else ""
+    return f"{value:.6g}{spread} {unit}".rstrip()
 
 
 # --- entry point: every error becomes one line ---------------------------------------------------
@@ -251,11 +363,14 @@ def _usage_line(exc: Exception) -> str:
             "command",
             message[len("no such command") :].strip(" .") + " is not a command",
         )
-        message += "; choose from: presets, run, export"
+        message += "; choose from: " + ", ".join(_COMMANDS)
     else:
         field = "usage"
     message = " ".join(message.split()) or type(exc).__name__
     return f"{field}: {message[0].lower()}{message[1:]}"
+
+
+_COMMANDS = ("presets", "run", "resume", "export", "inspect", "convert", "render")
 
 
 def _fail(line: str, code: int) -> int:

@@ -74,6 +74,12 @@ class Drift(Protocol):
         may use it to time collisions within the step consistently with the kicks.
         """
 
+    def state(self) -> dict[str, np.ndarray]:
+        """Arrays a checkpoint needs to continue bit for bit (empty if the mode keeps none)."""
+
+    def load_state(self, arrays: dict[str, np.ndarray]) -> None:
+        """Take back what `state` returned."""
+
 
 def make_drift(mode: CollisionMode) -> Drift:
     """The drift object for a collision mode name."""
@@ -134,7 +140,18 @@ def _refuse_runaway(particles: Particles, box: Box, dt: float) -> None:
         )
 
 
-class NoCollisions:
+class _Stateless:
+    """A mode whose drift depends on the particles alone (work arrays are rebuilt identically)."""
+
+    def state(self) -> dict[str, np.ndarray]:
+        """Nothing to save."""
+        return {}
+
+    def load_state(self, arrays: dict[str, np.ndarray]) -> None:
+        """Nothing to restore."""
+
+
+class NoCollisions(_Stateless):
     """Pass-through: free flight with exact wall reflection (or periodic wrapping)."""
 
     def drift(
@@ -150,7 +167,7 @@ class NoCollisions:
         _free_flight(particles, box, dt, tally)
 
 
-class StepCollisions:
+class StepCollisions(_Stateless):
     """The seed's method: drift, fold back from walls, resolve overlapping pairs in index order.
 
     A collision is only detected if the disks overlap at the end of a step, so fast or small disks
@@ -204,6 +221,23 @@ class ExactCollisions:
         self.events = 0
         #: Times the event queue was built from scratch.
         self.rebuilds = 0
+
+    def state(self) -> dict[str, np.ndarray]:
+        """The event queue and lazily updated positions, and the event counters."""
+        out: dict[str, np.ndarray] = {
+            "events": np.array([self.events, self.rebuilds], dtype=np.int64)
+        }
+        if self._state is not None and self._written is not None:
+            out |= {f"queue/{name}": array for name, array in self._state.items()}
+            out["written"] = self._written
+        return out
+
+    def load_state(self, arrays: dict[str, np.ndarray]) -> None:
+        """Continue from a saved queue (or rebuild it at the next drift if none was saved)."""
+        self.events, self.rebuilds = (int(x) for x in arrays["events"])
+        queue = {k.removeprefix("queue/"): v for k, v in arrays.items() if k.startswith("queue/")}
+        self._state = {name: np.array(array) for name, array in queue.items()} or None
+        self._written = np.array(arrays["written"]) if "written" in arrays else None
 
     def _is_current(self, particles: Particles) -> bool:
         return (

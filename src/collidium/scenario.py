@@ -26,6 +26,11 @@ A scenario file::
     n = 200
     speed = 10.0                  # velocity components uniform in [-speed, speed], m/s
 
+    [[observers]]                 # measurements and writers attached to the simulation
+    kind = "speeds"               # "energy" | "speeds" | "thermo" | "collisions" | "tracer" |
+    interval = 0.5                # "trajectory"; fired every `every` steps or `interval` s,
+    after = 5.0                   # from time `after` on
+
 `Scenario.build` turns it into a `Simulation`; the random groups draw, in group order, from one
 ``numpy.random.default_rng(seed)``, so a scenario always builds the same state bit for bit. Every
 validation problem becomes one `InputError` ``field.path: reason``.
@@ -57,6 +62,19 @@ from collidium.containers import Box
 from collidium.errors import InputError
 from collidium.forces import Coulomb
 from collidium.initial import balanced_charges, random_positions, rhombus_rack, uniform_velocities
+from collidium.io.trajectory import GSDWriter
+from collidium.observers import (
+    After,
+    CollisionRate,
+    EnergySeries,
+    Every,
+    Interval,
+    Observer,
+    SpeedHistogram,
+    Thermo,
+    Tracer,
+    Trigger,
+)
 from collidium.simulation import Simulation, outside_detail, overlap_detail
 from collidium.state import FloatArray, Particles
 
@@ -147,6 +165,115 @@ class CoulombSpec(_Model):
 
 
 ForceSpec = Annotated[CoulombSpec, Field(discriminator="type")]
+
+
+class _ObserverSpec(_Model):
+    """When an observer fires: every ``every`` steps or every ``interval`` s (default every
+    step), from time ``after`` (s) on."""
+
+    every: Annotated[int, Field(ge=1)] | None = None
+    interval: Positive | None = None
+    after: NonNegative | None = None
+
+    @field_validator("interval")
+    @classmethod
+    def _one_period(cls, value: float | None, info: ValidationInfo) -> float | None:
+        if value is not None and info.data.get("every") is not None:
+            raise ValueError("give either every (steps) or interval (s), not both")
+        return value
+
+    def trigger(self) -> Trigger:
+        """The trigger these fields describe."""
+        base: Trigger = (
+            Interval(self.interval) if self.interval is not None else Every(self.every or 1)
+        )
+        return base if self.after is None else After(self.after, base)
+
+
+class EnergySpec(_ObserverSpec):
+    """`EnergySeries`: kinetic, potential, total energy, total speed and momentum over time."""
+
+    kind: Literal["energy"] = "energy"
+
+    def build(self) -> Observer:
+        """The observer this describes."""
+        return EnergySeries(self.trigger())
+
+
+class SpeedsSpec(_ObserverSpec):
+    """`SpeedHistogram`: speeds binned (``bins`` over ``range`` in m/s) and accumulated."""
+
+    kind: Literal["speeds"] = "speeds"
+    bins: Annotated[int, Field(ge=1, le=100_000)] = 30
+    range: Vector = Field(default_factory=lambda: [0.0, 30.0])
+
+    @field_validator("range")
+    @classmethod
+    def _ordered(cls, value: list[float]) -> list[float]:
+        if not 0 <= value[0] < value[1]:
+            raise ValueError(f"must be [low, high] with 0 <= low < high, got {value}")
+        return value
+
+    def build(self) -> Observer:
+        """The observer this describes."""
+        return SpeedHistogram(self.bins, (self.range[0], self.range[1]), self.trigger())
+
+
+class ThermoSpec(_ObserverSpec):
+    """`Thermo`: temperature, wall and virial pressure."""
+
+    kind: Literal["thermo"] = "thermo"
+
+    def build(self) -> Observer:
+        """The observer this describes."""
+        return Thermo(self.trigger())
+
+
+class CollisionsSpec(_ObserverSpec):
+    """`CollisionRate`: collision rate, mean free time and path."""
+
+    kind: Literal["collisions"] = "collisions"
+
+    def build(self) -> Observer:
+        """The observer this describes."""
+        return CollisionRate(self.trigger())
+
+
+class TracerSpec(_ObserverSpec):
+    """`Tracer`: paths of the listed particles (all if omitted) and their mean-square
+    displacement."""
+
+    kind: Literal["tracer"] = "tracer"
+    particles: list[Annotated[int, Field(ge=0)]] | None = None
+
+    def build(self) -> Observer:
+        """The observer this describes."""
+        return Tracer(self.particles, self.trigger())
+
+
+class TrajectorySpec(_ObserverSpec):
+    """`GSDWriter`: frames written to ``path`` (a .gsd file)."""
+
+    kind: Literal["trajectory"] = "trajectory"
+    path: str
+    flush_seconds: NonNegative = 1.0
+
+    @field_validator("path")
+    @classmethod
+    def _gsd_suffix(cls, value: str) -> str:
+        if not value.endswith(".gsd"):
+            raise ValueError(f"must name a .gsd file, got {value!r}")
+        return value
+
+    def build(self) -> Observer:
+        """The observer this describes."""
+        return GSDWriter(self.path, self.trigger(), flush_seconds=self.flush_seconds)
+
+
+ObserverSpec = Annotated[
+    EnergySpec | SpeedsSpec | ThermoSpec | CollisionsSpec | TracerSpec | TrajectorySpec,
+    Field(discriminator="kind"),
+]
 
 
 @dataclass
@@ -270,6 +397,12 @@ _TAGGED: dict[str, type[_Model]] = {
     "random": RandomGroup,
     "rack": RackGroup,
     "coulomb": CoulombSpec,
+    "energy": EnergySpec,
+    "speeds": SpeedsSpec,
+    "thermo": ThermoSpec,
+    "collisions": CollisionsSpec,
+    "tracer": TracerSpec,
+    "trajectory": TrajectorySpec,
 }
 
 
@@ -290,6 +423,8 @@ class Scenario(_Model):
         Forces between particles.
     particles : list of ExplicitGroup, RandomGroup or RackGroup
         Particle groups, concatenated in order.
+    observers : list of observer specs
+        Measurements and writers attached by `build` (``sim.observers``).
     """
 
     model_config = ConfigDict(extra="forbid", strict=True)
@@ -301,6 +436,7 @@ class Scenario(_Model):
     run: RunSpec = Field(default_factory=RunSpec)
     forces: list[ForceSpec] = Field(default_factory=list)
     particles: Annotated[list[Group], Field(min_length=1)]
+    observers: list[ObserverSpec] = Field(default_factory=list)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Scenario:
@@ -397,7 +533,7 @@ class Scenario(_Model):
         """
         box, particles, offsets = self.initial_state()
         try:
-            return Simulation(
+            sim = Simulation(
                 box, particles, forces=[force.build() for force in self.forces], dt=self.run.dt,
                 collisions=self.run.collisions, seed=self.seed, name=self.name,
             )  # fmt: skip
@@ -405,6 +541,8 @@ class Scenario(_Model):
             if exc.particles:
                 raise self._placement_error(exc.particles, box, particles, offsets) from None
             raise InputError(_SIMULATION_FIELDS.get(exc.field, exc.field), exc.reason) from exc
+        sim.observers.extend(spec.build() for spec in self.observers)
+        return sim
 
     def _placement_error(
         self, culprits: tuple[int, ...], box: Box, particles: Particles, offsets: list[int]
@@ -656,7 +794,12 @@ def _reason(error: Any) -> tuple[str, str]:
         return path, "required field is missing"
     if kind in ("union_tag_not_found", "union_tag_invalid"):
         tag = str(ctx.get("discriminator", "kind")).strip("'")
-        expected = [name for name, model in _TAGGED.items() if tag in model.model_fields]
+        observer = bool(loc) and loc[0] == "observers"
+        expected = [
+            name
+            for name, model in _TAGGED.items()
+            if tag in model.model_fields and issubclass(model, _ObserverSpec) == observer
+        ]
         what = "missing" if kind == "union_tag_not_found" else f"unknown value {ctx.get('tag')!r}"
         return f"{path}.{tag}", f"{what}; choose from {', '.join(expected)}"
     if kind in _BOUNDS:

@@ -38,15 +38,19 @@ class MaxwellBoltzmann2D:
 
     def pdf(self, speed: ArrayLike) -> FloatArray:
         """Probability density at ``speed`` (m/s), in s/m."""
-        return np.asarray(sum(w * c.pdf(speed) for w, c in zip(self.weights, self.components)))
+        return np.asarray(
+            sum(w * c.pdf(speed) for w, c in zip(self.weights, self.components, strict=True))
+        )
 
     def cdf(self, speed: ArrayLike) -> FloatArray:
         """Probability of a speed below ``speed`` (m/s)."""
-        return np.asarray(sum(w * c.cdf(speed) for w, c in zip(self.weights, self.components)))
+        return np.asarray(
+            sum(w * c.cdf(speed) for w, c in zip(self.weights, self.components, strict=True))
+        )
 
     def mean(self) -> float:
         """Mean speed in m/s."""
-        return float(sum(w * c.mean() for w, c in zip(self.weights, self.components)))
+        return float(sum(w * c.mean() for w, c in zip(self.weights, self.components, strict=True)))
 
     def bin_probabilities(self, edges: ArrayLike) -> FloatArray:
         """Probability of each bin between consecutive ``edges`` (m/s)."""

@@ -130,7 +130,8 @@ class GSDWriter:
         self.frames_written = 0
 
     def attach(self, sim: Simulation) -> None:
-        """Open the file and write the current state as the first frame."""
+        """Open the file and write the current state as the first frame (when appending to a
+        file that has frames, only the trigger's frames are added)."""
         import gsd.hoomd
 
         if self._file is None:
@@ -141,6 +142,7 @@ class GSDWriter:
             self._last_flush = clock.monotonic()
             if self.append and len(self._file):
                 self._last_step = int(self._file[-1].configuration.step)
+                return
         self.update(sim)
 
     def update(self, sim: Simulation) -> None:
@@ -154,6 +156,12 @@ class GSDWriter:
         if now - self._last_flush >= self.flush_seconds:
             self._file.flush()
             self._last_flush = now
+
+    def flush(self) -> None:
+        """Write the buffered frames to disk now."""
+        if self._file is not None:
+            self._file.flush()
+            self._last_flush = clock.monotonic()
 
     def close(self) -> None:
         """Flush and close the file (the writer can be attached again to reopen it)."""

@@ -105,7 +105,7 @@ class EnergySeries(Measurement):
         """Last sample and the largest relative drift of the total energy."""
         if not self._rows:
             return {}
-        last = dict(zip(_COLUMNS, self._rows[-1]))
+        last = dict(zip(_COLUMNS, self._rows[-1], strict=True))
         return {
             "kinetic": last["kinetic"],
             "potential": last["potential"],
@@ -134,7 +134,7 @@ def plot_energy(
     speed_axis.plot(time, total_speed, color=SEED_COLOURS["total_speed"], label="total speed")
     speed_axis.set_ylabel("total speed (m/s)", color=SEED_COLOURS["total_speed"])
     lines = ax.get_lines() + speed_axis.get_lines()
-    ax.legend(lines, [line.get_label() for line in lines], loc="lower right", fontsize="small")
+    ax.legend(lines, [str(line.get_label()) for line in lines], loc="lower right", fontsize="small")
     return ax
 
 

@@ -151,12 +151,13 @@ class Thermo(Measurement):
         return _standard_error(_blocks(*self._wall_values())[0])
 
     def virial_pressure(self) -> float:
-        """``(N kT + W / 2) / A_c`` in N/m, W the collision virial rate plus the mean force virial."""
+        """``(N kT + W / 2) / A_c`` in N/m; W is the collision virial rate plus the mean force
+        virial."""
         if self.duration <= 0:
             return float("nan")
         gained = self._impulse[-1][0] - self._impulse[0][0]
         virial = gained / self.duration + float(np.mean(self._force_virial[1:]))
-        return (self.n * self.temperature + 0.5 * virial) / self.area
+        return float((self.n * self.temperature + 0.5 * virial) / self.area)
 
     def virial_pressure_error(self) -> float:
         """Standard error of the virial pressure in N/m (block averages)."""
