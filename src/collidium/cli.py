@@ -8,11 +8,9 @@ from __future__ import annotations
 
 import importlib
 import json
-import math
 import os
 import sys
 import tempfile
-import time as clock
 import tomllib
 from collections.abc import Sequence
 from pathlib import Path

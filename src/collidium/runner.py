@@ -16,7 +16,7 @@ from typing import Any
 
 from collidium.errors import InputError
 from collidium.io.trajectory import GSDWriter, keep_frames_through, read_trajectory, write_xyz
-from collidium.observers import CollisionRate, EnergyDrift, Every, SpeedHistogram, Thermo
+from collidium.observers import CollisionRate, EnergyDrift, Every, SpeedHistogram, Thermo, Trigger
 from collidium.simulation import Simulation, restore_with_meta
 
 #: Trajectory formats by file suffix.
@@ -86,7 +86,7 @@ class CheckpointWriter:
 
     def __init__(self, path: str | Path, period: int, job: Job, drift: EnergyDrift) -> None:
         self.path = Path(path)
-        self.trigger = Every(period)
+        self.trigger: Trigger = Every(period)
         self.job = job
         self.drift = drift
 
