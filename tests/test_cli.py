@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import json
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from collidium.cli import parse_settings
@@ -128,6 +131,20 @@ DT_ZERO = '[run]\ndt = 0.0\n[[particles]]\nkind = "random"\nn = 3\n'
         (["run", "missing.toml"], None, "missing.toml"),
         (["export", "gas", "-o", "no/such/dir/gas.toml"], None, "no/such/dir/gas.toml"),
         (["dance"], None, "command"),
+        (["run", "head-on", "--out", "run.txt"], None, "--out"),
+        (["run", "head-on", "--out", "run.gsd", "--every", "0"], None, "--every"),
+        (["run", "head-on", "--checkpoint-every", "5"], None, "--checkpoint-every"),
+        (["run", "head-on", "--out", "no/such/dir/run.gsd"], None, "no/such/dir/run.gsd"),
+        (["resume", "missing.ckpt"], None, "missing.ckpt"),
+        (["resume", "{file}"], BAD_TOML, "{file}"),
+        (["inspect", "{file}"], BAD_TOML, "{file}"),
+        (["inspect", "missing.gsd"], None, "missing.gsd"),
+        (["convert", "missing.gsd", "out.xyz"], None, "missing.gsd"),
+        (["convert", "missing.gsd", "out.txt"], None, "target"),
+        (["render", "head-on"], None, "--plots"),
+        (["render", "head-on", "--movie", "m.avi"], None, "--movie"),
+        (["render", "head-on", "--plots", "p", "--fps", "0"], None, "--fps"),
+        (["render", "{file}", "--plots", "p"], EXTRA, "particles.0.colour"),
     ],
 )
 def test_bad_input_gives_one_line_and_exit_2(tmp_path, args, toml, field):
@@ -141,6 +158,8 @@ def test_bad_input_gives_one_line_and_exit_2(tmp_path, args, toml, field):
     assert lines[0].startswith(f"error: {field.replace('{file}', str(file))}: "), lines[0]
     assert "Traceback" not in result.stderr
     assert result.stdout == ""
+    # Nothing half-written: the folder holds at most the scenario file the test wrote.
+    assert {p.name for p in tmp_path.iterdir()} <= {"scenario.toml"}
 
 
 def test_bad_toml_error_names_the_line(tmp_path):
@@ -184,3 +203,94 @@ def test_no_arguments_shows_help():
     result = collidium()
     assert result.returncode == 0
     assert "run" in result.stdout and "export" in result.stdout
+
+
+def test_run_json_reports_thermodynamics():
+    result = collidium("run", "gas", "--time", "20", "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    kT = summary["energy"]["kinetic"] / 200
+    assert summary["temperature"] == pytest.approx(kT, rel=1e-12)  # hard disks: KE constant
+    pressure = summary["pressure"]
+    assert set(pressure["walls"]) == {"left", "right", "bottom", "top"}
+    spread = 3 * (pressure["wall_error"] ** 2 + pressure["virial_error"] ** 2) ** 0.5
+    assert abs(pressure["wall"] - pressure["virial"]) < spread
+    assert 0.01 < summary["ks_pvalue"] <= 1.0
+    collisions = summary["collisions"]
+    assert collisions["rate"] == pytest.approx(collisions["pair"] / 20.0, rel=1e-12)
+    assert collisions["mean_free_time"] == pytest.approx(200 * 20.0 / (2 * collisions["pair"]))
+
+
+def test_run_table_shows_temperature_and_pressure():
+    result = collidium("run", "charged-gas", "--time", "1")
+    assert result.returncode == 0, result.stderr
+    for label in ("temperature kT", "wall pressure", "virial pressure", "KS p-value"):
+        assert label in result.stdout
+
+
+def test_trajectory_inspect_and_convert(tmp_path):
+    result = collidium("run", "gas", "--time", "1", "--out", "run.gsd", "--every", "20",
+                       cwd=tmp_path)  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    facts = json.loads(collidium("inspect", "run.gsd", "--json", cwd=tmp_path).stdout)
+    assert facts["frames"] == 6 and facts["n"] == 200 and facts["steps"] == [0, 100]
+    assert "energy/total" in facts["log"]
+    table = collidium("inspect", "run.gsd", cwd=tmp_path)
+    assert table.returncode == 0 and "frames" in table.stdout
+    assert collidium("convert", "run.gsd", "run.xyz", cwd=tmp_path).returncode == 0
+    assert (tmp_path / "run.xyz").read_text().count("Lattice=") == 6
+
+
+def test_xyz_output_directly(tmp_path):
+    result = collidium("run", "head-on", "--steps", "10", "--out", "run.xyz", "--every", "5",
+                       cwd=tmp_path)  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.xyz"]  # the staging .gsd is gone
+    assert (tmp_path / "run.xyz").read_text().count("Lattice=") == 3
+
+
+def test_killed_run_resumes_bitwise(tmp_path):
+    """SIGKILL a checkpointed run once its first checkpoint is on disk, resume it, and compare
+    the final state and the whole trajectory with the same run never stopped."""
+    import collidium as cd
+    from collidium.io.trajectory import read_trajectory
+
+    args = ["run", "gas", "--set", "n=600", "--steps", "8000", "--every", "500"]
+    whole = collidium(*args, "--out", "whole.gsd", "--checkpoint", "whole.ckpt", cwd=tmp_path)
+    assert whole.returncode == 0, whole.stderr
+    command = [sys.executable, "-m", "collidium", *args, "--out", "part.gsd", "--checkpoint",
+               "part.ckpt", "--checkpoint-every", "1000"]  # fmt: skip
+    process = subprocess.Popen(command, cwd=tmp_path, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 120
+    while not (tmp_path / "part.ckpt").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    assert process.returncode == -signal.SIGKILL
+    assert cd.restore(tmp_path / "part.ckpt").steps < 8000
+    resumed = collidium("resume", "part.ckpt", "--json", cwd=tmp_path)
+    assert resumed.returncode == 0, resumed.stderr
+    assert json.loads(resumed.stdout)["steps"] == 8000
+    a, b = cd.restore(tmp_path / "whole.ckpt"), cd.restore(tmp_path / "part.ckpt")
+    assert a.steps == b.steps == 8000
+    np.testing.assert_array_equal(a.particles.position, b.particles.position)
+    np.testing.assert_array_equal(a.particles.velocity, b.particles.velocity)
+    ta, tb = read_trajectory(tmp_path / "whole.gsd"), read_trajectory(tmp_path / "part.gsd")
+    np.testing.assert_array_equal(ta.step, 500 * np.arange(17))
+    np.testing.assert_array_equal(ta.step, tb.step)
+    np.testing.assert_array_equal(ta.position, tb.position)
+    for key in ta.log:
+        np.testing.assert_array_equal(ta.log[key], tb.log[key])
+
+
+def test_render_from_a_scenario_and_from_a_trajectory(tmp_path):
+    result = collidium("render", "charged-gas", "--time", "0.5", "--every", "10", "--plots",
+                       "plots", "--movie", "m.gif", cwd=tmp_path)  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split() == ["plots/energy.png", "plots/speeds.png", "m.gif"]
+    for name in ("plots/energy.png", "plots/speeds.png", "m.gif"):
+        assert (tmp_path / name).stat().st_size > 10_000
+    collidium("run", "head-on", "--steps", "20", "--out", "r.gsd", "--every", "5", cwd=tmp_path)
+    result = collidium("render", "r.gsd", "--movie", "r.mp4", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "r.mp4").read_bytes()[4:8] == b"ftyp"  # an MP4 container

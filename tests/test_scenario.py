@@ -435,3 +435,69 @@ def test_random_disks_clear_the_periodic_images_of_listed_ones():
     }
     sim = Scenario.from_dict(data).build()  # overlaps across the edge would be refused here
     assert sim.particles.n == 601
+
+
+OBSERVERS = """
+[[observers]]
+kind = "speeds"
+interval = 0.5
+after = 2.0
+bins = 20
+range = [0.0, 20.0]
+
+[[observers]]
+kind = "thermo"
+every = 10
+
+[[observers]]
+kind = "tracer"
+particles = [0, 3]
+
+[[observers]]
+kind = "trajectory"
+path = "{path}"
+every = 50
+"""
+
+
+def test_observers_from_the_scenario_file(tmp_path):
+    import collidium as cd
+    from collidium.io.trajectory import read_trajectory
+    from collidium.loading import load_scenario
+    from collidium.observers import SpeedHistogram, Thermo, Tracer
+
+    text = load_scenario("gas").to_toml() + OBSERVERS.format(path=tmp_path / "run.gsd")
+    file = tmp_path / "gas.toml"
+    file.write_text(text)
+    sim = cd.load(file)
+    speeds, thermo, tracer, writer = sim.observers
+    assert isinstance(speeds, SpeedHistogram) and speeds.bin_edges[-1] == 20.0
+    sim.run(time=5.0)
+    writer.close()
+    assert speeds.frames == 7  # t = 2.0, 2.5, ..., 5.0
+    assert isinstance(thermo, Thermo) and thermo.duration == pytest.approx(5.0)
+    assert isinstance(tracer, Tracer) and tracer.path.shape == (501, 2, 2)
+    assert read_trajectory(tmp_path / "run.gsd").frames == 11
+    # Written back out and read again, the scenario is the same.
+    assert Scenario.from_toml_string(load_scenario(file).to_toml()) == load_scenario(file)
+
+
+@pytest.mark.parametrize(
+    ("table", "field"),
+    [
+        ('kind = "speeds"\nevery = 2\ninterval = 1.0', "observers.0.interval"),
+        ('kind = "speeds"\nrange = [5.0, 1.0]', "observers.0.range"),
+        ('kind = "histogram"', "observers.0.kind"),
+        ('kind = "trajectory"\npath = "run.txt"', "observers.0.path"),
+        ('kind = "trajectory"', "observers.0.path"),
+        ('kind = "thermo"\nevery = 0', "observers.0.every"),
+        ('kind = "tracer"\nparticles = [-1]', "observers.0.particles.0"),
+    ],
+)
+def test_bad_observer_tables_name_the_field(table, field):
+    from collidium.loading import load_scenario
+
+    text = load_scenario("gas").to_toml() + "\n[[observers]]\n" + table + "\n"
+    with pytest.raises(InputError) as caught:
+        Scenario.from_toml_string(text)
+    assert caught.value.field == field

@@ -477,8 +477,12 @@ class Scenario(_Model):
         return cls.from_dict(data)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data (Python floats, ints, str, lists, dicts); unset optional values left out."""
-        return self.model_dump(mode="python", exclude_none=True)
+        """Plain data (Python floats, ints, str, lists, dicts); unset optional values and an empty
+        observer list left out."""
+        data = self.model_dump(mode="python", exclude_none=True)
+        if not data["observers"]:
+            del data["observers"]
+        return data
 
     def to_toml(self) -> str:
         """The scenario as TOML text; reading it back gives an equal scenario (floats bitwise)."""

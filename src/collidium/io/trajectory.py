@@ -310,22 +310,22 @@ def write_xyz(trajectory: Trajectory, path: str | Path) -> None:
     w, h = trajectory.width, trajectory.height
     pbc = "T T F" if trajectory.periodic else "F F F"
     names = np.array(TYPES)[type_ids(trajectory.charge)]
-    constant = np.column_stack([trajectory.mass, trajectory.radius, trajectory.charge])
+    zeros = np.zeros(trajectory.n)
     lines: list[str] = []
     for k in range(trajectory.frames):
         lines.append(str(trajectory.n))
         lines.append(
-            f'Lattice="{w!r} 0 0 0 {h!r} 0 0 0 1" Origin="{-w / 2!r} {-h / 2!r} -0.5" '
+            f'Lattice="{w:.17g} 0 0 0 {h:.17g} 0 0 0 1" Origin="{-w / 2:.17g} {-h / 2:.17g} -0.5" '
             "Properties=species:S:1:pos:R:3:velo:R:3:mass:R:1:radius:R:1:charge:R:1 "
-            f'Time={trajectory.time[k]!r} Step={int(trajectory.step[k])} pbc="{pbc}"'
+            f'Time={trajectory.time[k]:.17g} Step={int(trajectory.step[k])} pbc="{pbc}"'
         )
         x, v = trajectory.position[k], trajectory.velocity[k]
-        for i in range(trajectory.n):
-            m, r, q = constant[i]
-            lines.append(
-                f"{names[i]} {x[i, 0]!r} {x[i, 1]!r} 0.0 {v[i, 0]!r} {v[i, 1]!r} 0.0 "
-                f"{m!r} {r!r} {q!r}"
-            )
+        table = np.column_stack([x, zeros, v, zeros, trajectory.mass, trajectory.radius,
+                                 trajectory.charge])  # fmt: skip
+        lines.extend(
+            f"{name} " + " ".join(f"{value:.9g}" for value in row)
+            for name, row in zip(names, table, strict=True)
+        )
     Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 

@@ -128,7 +128,9 @@ class Measurement:
 
     A subclass implements `compute`; `update` (called by the run loop) is ``compute(sim,
     reset=False)``, so attached to a simulation a measurement accumulates over the run, while a
-    direct ``compute(sim)`` measures the current state afresh.
+    direct ``compute(sim)`` measures the current state afresh. A measurement over a time window
+    (``baseline = True``: series, averages, rates) takes its first sample when the run starts, or,
+    under an `After` trigger, when that time comes.
 
     Parameters
     ----------
@@ -136,17 +138,22 @@ class Measurement:
         When the run loop samples: a trigger, a number of steps, or None for every step.
     """
 
+    #: Whether the state when the run starts is the first sample (the start of the window).
+    baseline = True
+
     def __init__(self, trigger: Trigger | int | None = None) -> None:
         self.trigger: Trigger = as_trigger(trigger)
 
     def attach(self, sim: Simulation) -> None:
-        """Take the first sample when a run starts, unless samples were taken already."""
-        if not self.sampled:
+        """Take the first sample when a run starts, unless samples were taken already or the
+        trigger waits for a later time."""
+        waiting = isinstance(self.trigger, After) and sim.time < self.trigger.time * (1 - 1e-12)
+        if self.baseline and not self.sampled and not waiting:
             self.compute(sim)
 
     def update(self, sim: Simulation) -> None:
-        """Add a sample (called by the run loop)."""
-        self.compute(sim, reset=False)
+        """Add a sample (called by the run loop); the first one starts afresh."""
+        self.compute(sim, reset=not self.sampled)
 
     @property
     def sampled(self) -> bool:

@@ -40,6 +40,9 @@ class SpeedHistogram(Measurement):
     so for a time average its p-value is only indicative.
     """
 
+    #: Snapshots are taken when the trigger fires only (not when the run starts).
+    baseline = False
+
     def __init__(
         self,
         bins: int = 30,

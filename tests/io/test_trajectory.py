@@ -1,0 +1,178 @@
+"""GSD trajectories: the HOOMD schema other tools read, flushing, damage, XYZ export."""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import subprocess
+import sys
+import time
+
+import gsd.hoomd
+import numpy as np
+import pytest
+
+import collidium as cd
+from collidium.errors import InputError
+from collidium.io import describe_file
+from collidium.io.trajectory import (
+    TYPES,
+    GSDWriter,
+    keep_frames_through,
+    read_trajectory,
+    write_xyz,
+)
+
+
+def record(tmp_path, preset="charged-gas", every=10, steps=50, **overrides):
+    sim = cd.load(preset, **overrides)
+    path = tmp_path / "run.gsd"
+    with GSDWriter(path, every) as writer:
+        sim.observers.append(writer)
+        sim.run(steps=steps)
+    return sim, path
+
+
+def test_frames_follow_the_hoomd_schema(tmp_path):
+    sim, path = record(tmp_path)
+    with gsd.hoomd.open(path) as trajectory:
+        assert len(trajectory) == 6  # the start, then every 10 of 50 steps
+        frame = trajectory[-1]
+    assert frame.configuration.step == 50
+    assert frame.configuration.dimensions == 2
+    np.testing.assert_array_equal(frame.configuration.box, [20, 20, 0, 0, 0, 0])
+    p = sim.particles
+    assert p.n == frame.particles.N
+    np.testing.assert_array_equal(frame.particles.position[:, :2], p.position.astype(np.float32))
+    np.testing.assert_array_equal(frame.particles.position[:, 2], 0.0)
+    np.testing.assert_array_equal(frame.particles.velocity[:, :2], p.velocity.astype(np.float32))
+    np.testing.assert_array_equal(frame.particles.diameter, 0.5)
+    np.testing.assert_array_equal(frame.particles.mass, 1.0)
+    np.testing.assert_array_equal(frame.particles.charge, p.charge.astype(np.float32))
+    assert frame.particles.types == list(TYPES)
+    named = np.array(TYPES)[frame.particles.typeid]
+    assert set(named[p.charge > 0]) == {"positive"} and set(named[p.charge < 0]) == {"negative"}
+    log = gsd.hoomd.read_log(path)
+    np.testing.assert_array_equal(log["configuration/step"], [0, 10, 20, 30, 40, 50])
+    assert log["log/energy/total"][-1] == pytest.approx(sim.energy().total, rel=1e-15)
+    assert log["log/collisions/pair"][-1] == sim.counters.pair_collisions
+    np.testing.assert_array_equal(log["log/impulse/walls"][-1], sim.tally.impulse[1:])
+    np.testing.assert_allclose(log["log/collidium/time"], np.arange(6) * 0.1, rtol=1e-15)
+
+
+def test_freud_reads_the_file(tmp_path):
+    """freud builds its 2D box from the GSD box and finds each disk's contacts in the frame."""
+    freud = pytest.importorskip("freud")
+    _, path = record(tmp_path, "pool-break", every=100, steps=100)
+    with gsd.hoomd.open(path) as trajectory:
+        frame = trajectory[0]  # the rack: 224 balls in hexagonal packing, tiny gaps
+    box = freud.box.Box.from_box(frame.configuration.box, dimensions=frame.configuration.dimensions)
+    assert box.is2D and (box.Lx, box.Ly) == (40.0, 20.0)
+    query = freud.locality.AABBQuery(box, frame.particles.position)
+    pairs = query.query(frame.particles.position, {"r_max": 0.51, "exclude_ii": True})
+    neighbours = np.bincount(
+        pairs.toNeighborList().query_point_indices, minlength=frame.particles.N
+    )
+    # Interior balls of a hexagonal rack touch six others; the cue ball touches none.
+    assert neighbours.max() == 6
+    assert neighbours[np.argmin(frame.particles.position[:, 0])] == 0
+
+
+def test_periodic_images_and_flag(tmp_path):
+    sim, path = record(tmp_path, "gas", every=100, steps=400, **{"box.boundary": "periodic"})
+    trajectory = read_trajectory(path)
+    assert trajectory.periodic
+    with gsd.hoomd.open(path) as frames:
+        np.testing.assert_array_equal(frames[-1].particles.image[:, :2], sim.particles.image)
+
+
+def test_read_back_into_arrays(tmp_path):
+    sim, path = record(tmp_path)
+    trajectory = read_trajectory(path)
+    assert (trajectory.frames, trajectory.n) == (6, 200)
+    assert trajectory.position.shape == (6, 200, 2) and trajectory.position.dtype == np.float64
+    np.testing.assert_allclose(trajectory.position[-1], sim.particles.position, atol=1e-5)
+    np.testing.assert_array_equal(trajectory.radius, sim.particles.radius)
+    assert not trajectory.periodic
+    assert describe_file(path)["frames"] == 6
+
+
+def test_appending_continues_and_trimming_cuts_back(tmp_path):
+    sim, path = record(tmp_path, steps=30)
+    sim.run(steps=5)  # not recorded
+    with GSDWriter(path, 10, append=True) as writer:
+        sim.observers.append(writer)
+        sim.run(steps=25)
+    np.testing.assert_array_equal(read_trajectory(path).step, [0, 10, 20, 30, 40, 50, 60])
+    assert keep_frames_through(path, 40) == 5
+    np.testing.assert_array_equal(read_trajectory(path).step, [0, 10, 20, 30, 40])
+
+
+def test_xyz_export(tmp_path):
+    _, path = record(tmp_path)
+    trajectory = read_trajectory(path)
+    target = tmp_path / "run.xyz"
+    write_xyz(trajectory, target)
+    lines = target.read_text().splitlines()
+    assert len(lines) == 6 * (2 + 200)
+    assert lines[0] == "200"
+    header = lines[1]
+    assert 'Lattice="20 0 0 0 20 0 0 0 1"' in header and 'pbc="F F F"' in header
+    assert "Properties=species:S:1:pos:R:3:velo:R:3:mass:R:1:radius:R:1:charge:R:1" in header
+    last = np.array([line.split()[1:] for line in lines[-200:]], dtype=float)
+    # Nine significant digits give back the stored single-precision values exactly.
+    f32 = np.float32
+    np.testing.assert_array_equal(last[:, :2].astype(f32), trajectory.position[-1].astype(f32))
+    np.testing.assert_array_equal(last[:, 3:5].astype(f32), trajectory.velocity[-1].astype(f32))
+    np.testing.assert_array_equal(last[:, 8], trajectory.charge)
+
+
+def test_killed_writer_leaves_every_flushed_frame(tmp_path):
+    """SIGKILL a long run once frames are on disk: the file still opens, with every frame that
+    was flushed before the kill, each complete."""
+    path = tmp_path / "killed.gsd"
+    command = [sys.executable, "-m", "collidium", "run", "gas", "--set", "n=800",
+               "--time", "100000", "--out", str(path), "--every", "5"]  # fmt: skip
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    seen = 0
+    try:
+        deadline = time.monotonic() + 120
+        while seen < 3 and time.monotonic() < deadline and process.poll() is None:
+            time.sleep(0.2)
+            with contextlib.suppress(InputError):  # not created yet, or caught mid-write
+                seen = read_trajectory(path).frames
+    finally:
+        process.send_signal(signal.SIGKILL)
+        process.wait()
+    assert process.returncode == -signal.SIGKILL, process.stderr.read() if process.stderr else ""
+    assert seen >= 3
+    trajectory = read_trajectory(path)
+    assert trajectory.frames >= seen
+    np.testing.assert_array_equal(trajectory.step, 5 * np.arange(trajectory.frames))
+    assert np.isfinite(trajectory.position).all()
+    assert (np.abs(trajectory.position) <= 10.0).all()
+    energy = trajectory.log["energy/total"][:, 0]
+    np.testing.assert_allclose(energy, energy[0], rtol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "damage",
+    [
+        lambda data: data[: len(data) // 2],  # truncated
+        lambda data: data[:100] + b"\x00" * 200 + data[300:],  # header and index overwritten
+        lambda data: b"not a gsd file at all",
+        lambda data: b"",
+    ],
+)
+def test_damaged_file_gives_one_clear_error(tmp_path, damage):
+    _, path = record(tmp_path)
+    path.write_bytes(damage(path.read_bytes()))
+    with pytest.raises(InputError) as caught:
+        read_trajectory(path)
+    assert caught.value.field == str(path)
+    assert "\n" not in str(caught.value)
+
+
+def test_missing_file():
+    with pytest.raises(InputError, match="no such file"):
+        read_trajectory("does-not-exist.gsd")
