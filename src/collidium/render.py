@@ -11,11 +11,8 @@ from __future__ import annotations
 
 import contextlib
 import math
-import os
-import secrets
 import warnings
-from collections.abc import Callable, Generator, Iterator
-from functools import partial
+from collections.abc import Generator, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -26,6 +23,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
 from collidium.errors import InputError
+from collidium.io.atomic import replacing
 from collidium.io.trajectory import Trajectory, type_ids
 from collidium.observers.energy import plot_energy
 from collidium.observers.speeds import SpeedHistogram
@@ -249,7 +247,8 @@ def write_plots(trajectory: Trajectory, folder: str | Path) -> list[Path]:
     for name, make in (("energy.png", energy_figure), ("speeds.png", speed_figure)):
         figure = make(trajectory)
         path = folder / name
-        _atomic(path, partial(figure.savefig, dpi=PLOT_DPI))
+        with replacing(path) as temporary:
+            figure.savefig(temporary, dpi=PLOT_DPI)
         figure.clear()
         written.append(path)
     return written
@@ -476,16 +475,14 @@ def write_movie(
     except OSError as exc:
         raise InputError("--movie", f"cannot create {path.parent} ({exc.strerror})") from None
 
-    def render(target: Path) -> None:
-        movie = _MovieFigure(trajectory, dpi, bins, range)
-        pictures = _pictures(movie, trajectory.frames, progress)
-        try:
-            writer(target, pictures, fps)
-        finally:
-            pictures.close()
-            movie.close()
-
-    _atomic(path, render)
+    movie = _MovieFigure(trajectory, dpi, bins, range)
+    pictures = _pictures(movie, trajectory.frames, progress)
+    try:
+        with replacing(path) as temporary:
+            writer(temporary, pictures, fps)
+    finally:
+        pictures.close()
+        movie.close()
     return path
 
 
@@ -556,17 +553,3 @@ def _write_gif(target: Path, pictures: Iterator[np.ndarray], fps: float) -> None
     first.save(
         target, format="GIF", save_all=True, append_images=rest, duration=1000.0 / fps, loop=0
     )
-
-
-def _atomic(path: Path, write: Callable[[Path], object]) -> None:
-    """Call ``write`` on a temporary file beside ``path``, then move it onto ``path``; on any
-    failure (or an interrupt) the temporary is removed and ``path`` is left as it was."""
-    # A fresh name (not mkstemp, whose file would keep mode 0600): the writer creates it under
-    # the usual umask. The suffix stays last, for the writers that go by it.
-    temporary = path.with_name(f".{path.stem}.{secrets.token_hex(4)}.part{path.suffix}")
-    try:
-        write(temporary)
-        os.replace(temporary, path)
-    except BaseException:
-        temporary.unlink(missing_ok=True)
-        raise

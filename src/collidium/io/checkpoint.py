@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -18,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from collidium.errors import InputError
+from collidium.io.atomic import replacing
 
 FORMAT = "collidium-checkpoint"
 VERSION = 1
@@ -32,23 +32,12 @@ def write_checkpoint(path: str | Path, arrays: dict[str, np.ndarray], meta: dict
     InputError
         If the folder cannot be written.
     """
-    path = Path(path)
     header = {"format": FORMAT, "version": VERSION} | meta
     encoded = np.frombuffer(json.dumps(header).encode("utf-8"), dtype=np.uint8)
-    folder = path.parent if str(path.parent) else Path(".")
-    try:
-        handle, temporary = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
-    except OSError as exc:
-        raise InputError(str(path), f"cannot write a checkpoint: {exc.strerror or exc}") from None
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            np.savez(stream, allow_pickle=False, **({_META: encoded} | arrays))
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    with replacing(path) as temporary, temporary.open("wb") as stream:
+        np.savez(stream, allow_pickle=False, **({_META: encoded} | arrays))
+        stream.flush()
+        os.fsync(stream.fileno())
 
 
 def read_checkpoint(path: str | Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from collidium.errors import InputError
+from collidium.io.atomic import replacing
 from collidium.observers.base import Trigger, as_trigger
 from collidium.state import FloatArray
 
@@ -291,12 +292,9 @@ def keep_frames_through(path: str | Path, step: int) -> int:
     there); returns how many frames remain. The file is replaced atomically."""
     import gsd.hoomd
 
-    path = Path(path)
     kept = [f for f in iter_frames(path) if int(f.configuration.step) <= step]
-    temporary = path.with_name(f".{path.name}.resume.tmp")
-    with gsd.hoomd.open(temporary, "w") as out:
+    with replacing(path) as temporary, gsd.hoomd.open(temporary, "w") as out:
         out.extend(kept)
-    temporary.replace(path)
     return len(kept)
 
 
@@ -326,7 +324,8 @@ def write_xyz(trajectory: Trajectory, path: str | Path) -> None:
             f"{name} " + " ".join(f"{value:.9g}" for value in row)
             for name, row in zip(names, table, strict=True)
         )
-    Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with replacing(path) as temporary:
+        temporary.write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
 def describe(path: str | Path) -> dict[str, Any]:
