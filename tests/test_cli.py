@@ -294,3 +294,15 @@ def test_render_from_a_scenario_and_from_a_trajectory(tmp_path):
     result = collidium("render", "r.gsd", "--movie", "r.mp4", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "r.mp4").read_bytes()[4:8] == b"ftyp"  # an MP4 container
+
+
+def test_scenario_trajectory_is_complete_after_a_cli_run(tmp_path):
+    from collidium.io.trajectory import read_trajectory
+    from collidium.loading import load_scenario
+
+    text = load_scenario("gas").to_toml()
+    text += '\n[[observers]]\nkind = "trajectory"\npath = "mine.gsd"\nevery = 10\n'
+    (tmp_path / "gas.toml").write_text(text)
+    result = collidium("run", "gas.toml", "--steps", "100", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert read_trajectory(tmp_path / "mine.gsd").frames == 11

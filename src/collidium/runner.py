@@ -23,7 +23,7 @@ from collidium.simulation import Simulation, restore_with_meta
 OUTPUT_SUFFIXES = (".gsd", ".xyz")
 
 #: How many samples the run's own measurements take at most (their collision parts are exact).
-SAMPLES = 2000
+SAMPLES = 500
 
 
 @dataclass
@@ -67,6 +67,18 @@ class Job:
             raise InputError("--checkpoint-every", "needs --checkpoint FILE")
         if self.out is not None and Path(self.out).suffix not in OUTPUT_SUFFIXES:
             raise InputError("--out", f"must end in {' or '.join(OUTPUT_SUFFIXES)}, got {self.out}")
+        for name in (self.out, self.checkpoint):
+            if name is not None and not Path(name).parent.is_dir():
+                raise InputError(name, f"cannot write: no folder {Path(name).parent}")
+
+    def record_drift(self, drift: EnergyDrift) -> None:
+        """Fold a segment's energy drift into the whole run's, measured against the energy at
+        the start of the whole run."""
+        assert self.initial_total is not None
+        scale = max(abs(self.initial_total), 1e-300)
+        offset = abs(drift.initial_total - self.initial_total)
+        worst = (offset + drift.max_rel_drift * abs(drift.initial_total)) / scale
+        self.max_rel_drift = max(self.max_rel_drift, worst)
 
     @property
     def trajectory(self) -> Path | None:
@@ -98,7 +110,7 @@ class CheckpointWriter:
         for observer in sim.observers:
             if isinstance(observer, GSDWriter):
                 observer.flush()
-        self.job.max_rel_drift = max(self.job.max_rel_drift, self.drift.max_rel_drift)
+        self.job.record_drift(self.drift)
         sim.save(self.path, job=asdict(self.job))
 
 
@@ -127,43 +139,31 @@ def execute(sim: Simulation, job: Job, progress: bool = False) -> dict[str, Any]
     remaining = job.end_step - sim.steps
     if remaining < 0:
         raise InputError("steps", f"the run is already past step {job.end_step}")
+    if job.initial_total is None:
+        job.initial_total = sim.energy().total
     period = max(1, remaining // SAMPLES)
     drift, thermo, rate = EnergyDrift(), Thermo(period), CollisionRate(period)
     sim.observers += [drift, thermo, rate]
-    writer = None
     if job.trajectory is not None:
         append = sim.steps > 0 and job.trajectory.exists()
-        writer = GSDWriter(job.trajectory, Every(job.every), append=append)
-        sim.observers.append(writer)
+        sim.observers.append(GSDWriter(job.trajectory, Every(job.every), append=append))
     if job.checkpoint is not None and job.checkpoint_every is not None:
         sim.observers.append(CheckpointWriter(job.checkpoint, job.checkpoint_every, job, drift))
     start = clock.perf_counter()
     try:
         sim.run(steps=remaining, progress=progress)
-    finally:
-        if writer is not None:
-            writer.close()
+    finally:  # this run's trajectory and any a scenario file asked for
+        for observer in sim.observers:
+            if isinstance(observer, GSDWriter):
+                observer.close()
     wall = clock.perf_counter() - start
-    if job.initial_total is None:
-        job.initial_total = drift.initial_total
-    job.max_rel_drift = max(job.max_rel_drift, _drift_from(job.initial_total, drift))
+    job.record_drift(drift)
     if job.checkpoint is not None:
         sim.save(job.checkpoint, job=asdict(job))
     if job.out is not None and job.trajectory is not None and Path(job.out).suffix == ".xyz":
         write_xyz(read_trajectory(job.trajectory), job.out)
         job.trajectory.unlink()
     return summarise(sim, job, thermo, rate, wall)
-
-
-def _drift_from(initial_total: float, drift: EnergyDrift) -> float:
-    """The segment's largest drift measured against the whole run's initial energy."""
-    if drift.initial_total == initial_total:
-        return drift.max_rel_drift
-    scale = max(abs(initial_total), 1e-300)
-    worst = abs(drift.initial_total - initial_total) + drift.max_rel_drift * abs(
-        drift.initial_total
-    )
-    return worst / scale
 
 
 def summarise(

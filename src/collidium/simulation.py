@@ -8,7 +8,7 @@ Run loop, one step of length dt:
 3. forces at the new positions, kick: ``v += a dt/2``;
 4. ``time += dt``, ``steps += 1``;
 5. audit: a NaN/infinity or a particle outside the vessel stops the run with `SimulationError`;
-6. observers whose trigger fires on ``steps`` are updated.
+6. observers whose trigger fires (``trigger(sim)``) are updated.
 """
 
 from __future__ import annotations

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import stats
 
 from collidium.errors import InputError
 from collidium.state import FloatArray
@@ -30,6 +29,8 @@ class MaxwellBoltzmann2D:
     def __init__(self, kT: float, mass: ArrayLike) -> None:
         if not np.isfinite(kT) or kT <= 0:
             raise InputError("temperature", f"must be a finite number > 0, got {kT!r}")
+        from scipy import stats  # imported on first use: it is slow to load
+
         masses, counts = np.unique(np.atleast_1d(np.asarray(mass, dtype=float)), return_counts=True)
         self.kT = float(kT)
         self.masses = masses

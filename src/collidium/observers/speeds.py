@@ -6,7 +6,6 @@ import math
 from typing import TYPE_CHECKING, Any, Self
 
 import numpy as np
-from scipy import optimize, stats
 
 from collidium.errors import InputError
 from collidium.observers.base import Measurement, Trigger, new_axes
@@ -116,6 +115,8 @@ class SpeedHistogram(Measurement):
 
     def ks(self) -> tuple[float, float]:
         """Kolmogorov-Smirnov statistic and p-value of the speeds against `maxwell_boltzmann`."""
+        from scipy import stats  # imported on first use: it is slow to load
+
         result = stats.kstest(self.speeds, self.maxwell_boltzmann().cdf)
         return float(result.statistic), float(result.pvalue)
 
@@ -126,6 +127,8 @@ class SpeedHistogram(Measurement):
         by its Poisson error. This uses the shape of the distribution only, so it checks the
         equilibrium independently of the kinetic energy.
         """
+        from scipy import optimize
+
         total = self.speeds.size
         masses = np.concatenate(self._masses)
 
