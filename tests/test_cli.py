@@ -306,3 +306,23 @@ def test_scenario_trajectory_is_complete_after_a_cli_run(tmp_path):
     result = collidium("run", "gas.toml", "--steps", "100", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert read_trajectory(tmp_path / "mine.gsd").frames == 11
+
+
+@pytest.mark.parametrize("kind", ["gsd", "ckpt"])
+def test_truncated_files_give_one_line_on_every_command(tmp_path, kind):
+    extra = ["--out", "run.gsd"] if kind == "gsd" else ["--checkpoint", "run.ckpt"]
+    assert collidium("run", "gas", "--steps", "50", *extra, cwd=tmp_path).returncode == 0
+    path = tmp_path / f"run.{kind}"
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+    commands = [["inspect", path.name]]
+    commands += (
+        [["render", path.name, "--plots", "p"], ["convert", path.name, "x.xyz"]]
+        if (kind == "gsd")
+        else [["resume", path.name]]
+    )
+    for command in commands:
+        result = collidium(*command, cwd=tmp_path)
+        assert result.returncode == 2, result.stderr
+        assert result.stderr.startswith(f"error: {path.name}: ") and result.stderr.count("\n") == 1
+        assert "Traceback" not in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]

@@ -81,13 +81,8 @@ class Thermo(Measurement):
             self._time, self._kT, self._impulse, self._force_virial = [], [], [], []
             self.n = sim.particles.n
             box = sim.container
-            inset = (
-                0.0
-                if box.periodic
-                else 2.0 * float(np.mean(sim.particles.radius))
-                if sim.particles.n
-                else 0.0
-            )
+            walled = not box.periodic and self.n > 0
+            inset = 2.0 * float(np.mean(sim.particles.radius)) if walled else 0.0
             self.periodic = box.periodic
             #: Lengths (m) of the lines of contact of the left/right and of the bottom/top walls.
             self.contact = (box.height - inset, box.width - inset)
