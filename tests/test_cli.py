@@ -134,7 +134,8 @@ DT_ZERO = '[run]\ndt = 0.0\n[[particles]]\nkind = "random"\nn = 3\n'
         (["run", "head-on", "--out", "run.txt"], None, "--out"),
         (["run", "head-on", "--out", "run.gsd", "--every", "0"], None, "--every"),
         (["run", "head-on", "--checkpoint-every", "5"], None, "--checkpoint-every"),
-        (["run", "head-on", "--out", "no/such/dir/run.gsd"], None, "no/such/dir/run.gsd"),
+        (["run", "head-on", "--out", "no/such/dir/run.gsd"], None, "--out"),
+        (["run", "head-on", "--checkpoint", "no/such/dir/r.ckpt"], None, "--checkpoint"),
         (["resume", "missing.ckpt"], None, "missing.ckpt"),
         (["resume", "{file}"], BAD_TOML, "{file}"),
         (["inspect", "{file}"], BAD_TOML, "{file}"),
@@ -255,19 +256,35 @@ def test_killed_run_resumes_bitwise(tmp_path):
     import collidium as cd
     from collidium.io.trajectory import read_trajectory
 
-    args = ["run", "gas", "--set", "n=600", "--steps", "8000", "--every", "500"]
+    # About 4 s of work with a checkpoint half-way, so frames past it reach the disk (flushed
+    # every second) before the kill.
+    args = ["run", "gas", "--set", "n=600", "--set", "speed=40", "--steps", "8000", "--every",
+            "500"]  # fmt: skip
     whole = collidium(*args, "--out", "whole.gsd", "--checkpoint", "whole.ckpt", cwd=tmp_path)
     assert whole.returncode == 0, whole.stderr
     command = [sys.executable, "-m", "collidium", *args, "--out", "part.gsd", "--checkpoint",
-               "part.ckpt", "--checkpoint-every", "1000"]  # fmt: skip
+               "part.ckpt", "--checkpoint-every", "4000"]  # fmt: skip
     process = subprocess.Popen(command, cwd=tmp_path, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 120
-    while not (tmp_path / "part.ckpt").exists() and time.monotonic() < deadline:
+
+    def past_checkpoint() -> bool:
+        """A checkpoint is on disk and frames after it too (the resume must cut them)."""
+        if not (tmp_path / "part.ckpt").exists():
+            return False
+        try:
+            last = read_trajectory(tmp_path / "part.gsd").step[-1]
+            return bool(last > cd.restore(tmp_path / "part.ckpt").steps)
+        except cd.InputError:  # caught mid-write
+            return False
+
+    while not past_checkpoint() and time.monotonic() < deadline and process.poll() is None:
         time.sleep(0.05)
     process.send_signal(signal.SIGKILL)
     process.wait()
     assert process.returncode == -signal.SIGKILL
-    assert cd.restore(tmp_path / "part.ckpt").steps < 8000
+    stopped = cd.restore(tmp_path / "part.ckpt").steps
+    assert stopped < 8000
+    assert read_trajectory(tmp_path / "part.gsd").step[-1] > stopped
     resumed = collidium("resume", "part.ckpt", "--json", cwd=tmp_path)
     assert resumed.returncode == 0, resumed.stderr
     assert json.loads(resumed.stdout)["steps"] == 8000

@@ -105,7 +105,7 @@ def run_command(
     job = Job(
         end_step=count, out=None if out is None else str(out), every=frame_period,
         checkpoint=None if checkpoint is None else str(checkpoint),
-        checkpoint_every=checkpoint_every,
+        checkpoint_every=checkpoint_every, observers=spec.to_dict().get("observers", []),
     )  # fmt: skip
     sim = spec.build()
     _report(execute(sim, job, progress=not as_json and sys.stderr.isatty()), as_json)

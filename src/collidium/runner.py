@@ -1,22 +1,35 @@
 """A run as the command line does it: a simulation taken to an end step with its trajectory,
 checkpoints and measurements, and resumable from any checkpoint.
 
-The job (end step, output file, checkpoint file and periods) is stored in each checkpoint, so
-``collidium resume run.ckpt`` finishes the interrupted run: the trajectory is cut back to the
-checkpoint's step and continued, and the final state is bitwise the uninterrupted run's.
+The job (end step, output files, checkpoint file and periods, the scenario file's observers) is
+stored in each checkpoint, with its paths relative to the checkpoint's folder, so
+``collidium resume run.ckpt`` finishes the interrupted run from anywhere: trajectories are cut back
+to the checkpoint's step and continued, and the final state and trajectories are bitwise those of
+the run that was never stopped.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import time as clock
-from dataclasses import asdict, dataclass
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
 from collidium.errors import InputError
 from collidium.io.trajectory import GSDWriter, keep_frames_through, read_trajectory, write_xyz
-from collidium.observers import CollisionRate, EnergyDrift, Every, SpeedHistogram, Thermo, Trigger
+from collidium.observers import (
+    CollisionRate,
+    EnergyDrift,
+    Every,
+    Measurement,
+    SpeedHistogram,
+    Thermo,
+    Trigger,
+)
+from collidium.scenario import build_observers
 from collidium.simulation import Simulation, restore_with_meta
 
 #: Trajectory formats by file suffix.
@@ -28,7 +41,7 @@ SAMPLES = 500
 
 @dataclass
 class Job:
-    """What a run was asked to do.
+    """What a run was asked to do. Paths are made absolute when the job is created.
 
     Attributes
     ----------
@@ -42,10 +55,12 @@ class Job:
         Checkpoint file, rewritten every ``checkpoint_every`` steps and at the end.
     checkpoint_every : int or None
         Steps between checkpoints.
+    observers : list of dict
+        The scenario file's observer tables, rebuilt when the run resumes.
     initial_total : float or None
         Total energy at the start of the whole run (kept across resumes), J.
     max_rel_drift : float
-        Largest relative energy drift seen before the last checkpoint.
+        Largest relative energy drift from ``initial_total`` so far.
     """
 
     end_step: int
@@ -53,6 +68,7 @@ class Job:
     every: int = 10
     checkpoint: str | None = None
     checkpoint_every: int | None = None
+    observers: list[dict[str, Any]] = field(default_factory=list)
     initial_total: float | None = None
     max_rel_drift: float = 0.0
 
@@ -67,18 +83,19 @@ class Job:
             raise InputError("--checkpoint-every", "needs --checkpoint FILE")
         if self.out is not None and Path(self.out).suffix not in OUTPUT_SUFFIXES:
             raise InputError("--out", f"must end in {' or '.join(OUTPUT_SUFFIXES)}, got {self.out}")
-        for name in (self.out, self.checkpoint):
-            if name is not None and not Path(name).parent.is_dir():
-                raise InputError(name, f"cannot write: no folder {Path(name).parent}")
-
-    def record_drift(self, drift: EnergyDrift) -> None:
-        """Fold a segment's energy drift into the whole run's, measured against the energy at
-        the start of the whole run."""
-        assert self.initial_total is not None
-        scale = max(abs(self.initial_total), 1e-300)
-        offset = abs(drift.initial_total - self.initial_total)
-        worst = (offset + drift.max_rel_drift * abs(drift.initial_total)) / scale
-        self.max_rel_drift = max(self.max_rel_drift, worst)
+        self.out = _writable("--out", self.out)
+        self.checkpoint = _writable("--checkpoint", self.checkpoint)
+        self.observers = [dict(spec) for spec in self.observers]
+        for k, spec in enumerate(self.observers):
+            if "path" in spec:
+                spec["path"] = _writable(f"observers.{k}.path", spec["path"])
+        targets = [str(path) for path in self.files()]
+        if self.out is not None and Path(self.out) != self.trajectory:
+            targets.append(self.out)  # .xyz output beside its staging .gsd
+        if self.checkpoint is not None:
+            targets.append(self.checkpoint)
+        if len(set(targets)) < len(targets):
+            raise InputError("--checkpoint", "the trajectory and checkpoint files must differ")
 
     @property
     def trajectory(self) -> Path | None:
@@ -88,11 +105,56 @@ class Job:
         out = Path(self.out)
         return out if out.suffix == ".gsd" else out.with_name(f".{out.name}.gsd")
 
+    def files(self) -> list[Path]:
+        """Every trajectory the run writes (its own and the scenario file's)."""
+        paths = [Path(spec["path"]) for spec in self.observers if "path" in spec]
+        return paths if self.trajectory is None else [self.trajectory, *paths]
+
+    def to_meta(self, folder: Path) -> dict[str, Any]:
+        """The job as JSON data, paths relative to ``folder`` (the checkpoint's)."""
+
+        def relative(path: str | None) -> str | None:
+            return None if path is None else os.path.relpath(path, folder.absolute())
+
+        observers = [spec | ({"path": relative(spec["path"])} if "path" in spec else {})
+                     for spec in self.observers]  # fmt: skip
+        return asdict(self) | {"out": relative(self.out), "checkpoint": relative(self.checkpoint),
+                               "observers": observers}  # fmt: skip
+
+    @classmethod
+    def from_meta(cls, meta: dict[str, Any], folder: Path) -> Job:
+        """The job stored by `to_meta`, paths taken relative to ``folder``."""
+
+        def absolute(path: str | None) -> str | None:
+            return None if path is None else str(folder / path)
+
+        observers = [spec | ({"path": absolute(spec["path"])} if "path" in spec else {})
+                     for spec in meta.get("observers", [])]  # fmt: skip
+        return cls(**meta | {"out": absolute(meta.get("out")),
+                             "checkpoint": absolute(meta.get("checkpoint")),
+                             "observers": observers})  # fmt: skip
+
+
+def _writable(name: str, target: str | None) -> str | None:
+    """``target`` made absolute, after checking a file can be written there."""
+    if target is None:
+        return None
+    if not str(target).strip():
+        raise InputError(name, "needs a file name")
+    path = Path(target).absolute()
+    if path.is_dir():
+        raise InputError(name, f"{target} is a folder; give a file name")
+    if not path.parent.is_dir():
+        raise InputError(name, f"cannot write {target}: no folder {path.parent}")
+    if not os.access(path.parent, os.W_OK):
+        raise InputError(name, f"cannot write {target}: folder {path.parent} is read-only")
+    return str(path)
+
 
 class CheckpointWriter:
     """Observer that saves the simulation and its job every ``period`` steps.
 
-    Trajectory writers attached to the simulation are flushed first, so the file holds every
+    Trajectory writers attached to the simulation are flushed first, so the files hold every
     frame up to the checkpoint.
     """
 
@@ -110,45 +172,66 @@ class CheckpointWriter:
         for observer in sim.observers:
             if isinstance(observer, GSDWriter):
                 observer.flush()
-        self.job.record_drift(self.drift)
-        sim.save(self.path, job=asdict(self.job))
+        save(sim, self.job, self.drift)
+
+
+def save(sim: Simulation, job: Job, drift: EnergyDrift) -> None:
+    """Write ``job.checkpoint`` with the drift seen so far folded into the job."""
+    assert job.checkpoint is not None
+    job.max_rel_drift = max(job.max_rel_drift, drift.max_rel_drift)
+    checkpoint = Path(job.checkpoint)
+    sim.save(checkpoint, job=job.to_meta(checkpoint.parent))
 
 
 def resume(path: str | Path) -> tuple[Simulation, Job]:
-    """The simulation and job saved in a checkpoint, its trajectory cut back to the saved step.
+    """The simulation and job saved in a checkpoint, with the scenario file's observers attached
+    again and every trajectory cut back to the saved step.
 
     Raises
     ------
     InputError
-        If the checkpoint is damaged or holds no job, or its trajectory cannot be read.
+        If the checkpoint is damaged or holds no job, or a trajectory cannot be read.
     """
+    path = Path(path)
     sim, meta = restore_with_meta(path)
     if not isinstance(meta.get("job"), dict):
         raise InputError(str(path), "the checkpoint holds no run to resume (saved by sim.save?)")
     try:
-        job = Job(**meta["job"])
-    except TypeError as exc:
-        raise InputError(str(path), f"the checkpoint's job is damaged ({exc})") from None
-    if job.trajectory is not None and job.trajectory.exists():
-        keep_frames_through(job.trajectory, sim.steps)
+        job = Job.from_meta(meta["job"], path.parent)
+        observers = build_observers(job.observers)
+    except (TypeError, AttributeError) as exc:
+        raise InputError(str(path), f"the checkpoint's run is damaged ({exc})") from None
+    for file in job.files():
+        if file.exists():
+            keep_frames_through(file, sim.steps)
+    for observer in observers:
+        if isinstance(observer, GSDWriter):
+            observer.append = True
+    sim.observers += observers
     return sim, job
 
 
 def execute(sim: Simulation, job: Job, progress: bool = False) -> dict[str, Any]:
-    """Run ``sim`` to ``job.end_step`` with its outputs; returns the summary (`summarise`)."""
+    """Run ``sim`` to ``job.end_step`` with its outputs; returns the summary (`summarise`).
+
+    Observers already attached (a scenario file's) run along and are reported in the summary.
+    """
     remaining = job.end_step - sim.steps
     if remaining < 0:
         raise InputError("steps", f"the run is already past step {job.end_step}")
     if job.initial_total is None:
         job.initial_total = sim.energy().total
+    reported = [o for o in sim.observers if isinstance(o, Measurement)]
     period = max(1, remaining // SAMPLES)
-    drift, thermo, rate = EnergyDrift(), Thermo(period), CollisionRate(period)
+    drift = EnergyDrift(reference=job.initial_total)
+    thermo, rate = Thermo(period), CollisionRate(period)
     sim.observers += [drift, thermo, rate]
-    if job.trajectory is not None:
-        append = sim.steps > 0 and job.trajectory.exists()
-        sim.observers.append(GSDWriter(job.trajectory, Every(job.every), append=append))
-    if job.checkpoint is not None and job.checkpoint_every is not None:
-        sim.observers.append(CheckpointWriter(job.checkpoint, job.checkpoint_every, job, drift))
+    if remaining > 0:  # a finished run resumed again leaves its files alone
+        if job.trajectory is not None:
+            append = sim.steps > 0 and job.trajectory.exists()
+            sim.observers.append(GSDWriter(job.trajectory, Every(job.every), append=append))
+        if job.checkpoint is not None and job.checkpoint_every is not None:
+            sim.observers.append(CheckpointWriter(job.checkpoint, job.checkpoint_every, job, drift))
     start = clock.perf_counter()
     try:
         sim.run(steps=remaining, progress=progress)
@@ -157,23 +240,32 @@ def execute(sim: Simulation, job: Job, progress: bool = False) -> dict[str, Any]
             if isinstance(observer, GSDWriter):
                 observer.close()
     wall = clock.perf_counter() - start
-    job.record_drift(drift)
-    if job.checkpoint is not None:
-        sim.save(job.checkpoint, job=asdict(job))
-    if job.out is not None and job.trajectory is not None and Path(job.out).suffix == ".xyz":
-        write_xyz(read_trajectory(job.trajectory), job.out)
-        job.trajectory.unlink()
-    return summarise(sim, job, thermo, rate, wall)
+    if job.checkpoint is not None and remaining > 0:
+        save(sim, job, drift)
+    job.max_rel_drift = max(job.max_rel_drift, drift.max_rel_drift)
+    trajectory = job.trajectory
+    staged = job.out is not None and trajectory is not None and trajectory != Path(job.out)
+    if staged and trajectory is not None and trajectory.exists():
+        write_xyz(read_trajectory(trajectory), str(job.out))
+        trajectory.unlink()
+    return summarise(sim, job, thermo, rate, wall, reported)
 
 
 def summarise(
-    sim: Simulation, job: Job, thermo: Thermo, rate: CollisionRate, wall_seconds: float
+    sim: Simulation,
+    job: Job,
+    thermo: Thermo,
+    rate: CollisionRate,
+    wall_seconds: float,
+    reported: Sequence[Measurement] = (),
 ) -> dict[str, Any]:
     """Plain numbers describing a finished run (the ``--json`` object).
 
-    The state quantities are the final ones; temperature, pressures and collision rate are
-    averaged over the run (since the resume, for a resumed run); the KS p-value tests the final
-    speeds against Maxwell-Boltzmann at the final temperature.
+    The state quantities are the final ones and the energy drift is the whole run's; temperature,
+    pressures and collision rate are averaged over this run (since the resume, for a resumed
+    run); the KS p-value tests the final speeds against Maxwell-Boltzmann at the final
+    temperature. ``reported`` measurements (a scenario file's) add their summaries under
+    ``observers``.
     """
     summary: dict[str, Any] = sim.summary()
     summary["dt"] = float(sim.dt)
@@ -186,6 +278,10 @@ def summarise(
     speeds = SpeedHistogram().compute(sim).summary()
     summary["ks_statistic"] = speeds["ks_statistic"]
     summary["ks_pvalue"] = speeds["ks_pvalue"]
+    if reported:
+        summary["observers"] = [
+            {"observer": type(o).__name__} | o.summary() for o in reported if o.sampled
+        ]
     return finite(summary)
 
 

@@ -41,7 +41,7 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -274,6 +274,27 @@ ObserverSpec = Annotated[
     EnergySpec | SpeedsSpec | ThermoSpec | CollisionsSpec | TracerSpec | TrajectorySpec,
     Field(discriminator="kind"),
 ]
+
+
+def build_observers(specs: Sequence[Mapping[str, Any]]) -> list[Observer]:
+    """Observers from scenario ``[[observers]]`` tables (as plain data).
+
+    Raises
+    ------
+    InputError
+        Naming the first offending field, e.g. ``observers.1.bins: must be >= 1, got 0``.
+    """
+    try:
+        parsed = _Observers.model_validate({"observers": plain(list(specs))})
+    except ValidationError as exc:
+        raise InputError(*field_and_reason(exc)) from exc
+    return [spec.build() for spec in parsed.observers]
+
+
+class _Observers(_Model):
+    """Observer tables alone (what a checkpoint keeps of its scenario)."""
+
+    observers: list[ObserverSpec]
 
 
 @dataclass
@@ -545,8 +566,18 @@ class Scenario(_Model):
             if exc.particles:
                 raise self._placement_error(exc.particles, box, particles, offsets) from None
             raise InputError(_SIMULATION_FIELDS.get(exc.field, exc.field), exc.reason) from exc
+        self._check_traced(particles.n)
         sim.observers.extend(spec.build() for spec in self.observers)
         return sim
+
+    def _check_traced(self, n: int) -> None:
+        """Every particle a tracer follows exists."""
+        for k, spec in enumerate(self.observers):
+            for j, index in enumerate(getattr(spec, "particles", None) or []):
+                if index >= n:
+                    raise InputError(
+                        f"observers.{k}.particles.{j}", f"no particle {index}; there are {n}"
+                    )
 
     def _placement_error(
         self, culprits: tuple[int, ...], box: Box, particles: Particles, offsets: list[int]

@@ -32,11 +32,17 @@ def test_collisions_make_the_motion_diffusive():
     sim.observers.append(tracer)
     sim.run(time=200.0)
     msd, time = tracer.msd(), tracer.time - tracer.time[0]
-    late = time > 50.0
-    slope = np.diff(msd[late]) / np.diff(time[late])
-    d = tracer.diffusion_coefficient()
-    assert d > 0
-    assert np.mean(slope) == pytest.approx(4 * d, rel=0.15)
+
+    def slope(start, end):
+        inside = (time >= start) & (time <= end)
+        return np.polyfit(time[inside], msd[inside], 1)[0]
+
+    # Two disjoint windows long after the mean free time (about 0.5 s): the same growth rate
+    # within the spread of an average over 400 disks (a few %), unlike ballistic motion (where
+    # the rate doubles between them).
+    early, late = slope(50.0, 100.0), slope(150.0, 200.0)
+    assert late == pytest.approx(early, rel=0.2)
+    assert tracer.diffusion_coefficient() == pytest.approx(0.25 * slope(100.0, 200.0), rel=1e-9)
     assert msd[-1] < 0.01 * 2.0 * time[-1] ** 2  # <v^2> = 2 kT / m = 2
 
 

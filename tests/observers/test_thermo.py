@@ -91,16 +91,23 @@ def test_wall_and_virial_pressure_agree_with_coulomb_forces():
     assert abs(thermo.wall_pressure()["total"] - thermo.virial_pressure()) < 3 * both
 
 
+#: Reduced virial coefficients of hard disks (Clisby and McCoy 2006): Z = 1 + sum b_k eta^k.
+VIRIAL_SERIES = [2.0, 3.12801775, 4.25785446, 5.33689664, 6.36296, 7.35186, 8.3077, 9.2271, 10.1]
+
+
 @pytest.mark.parametrize("packing", [0.05, 0.3])
 def test_hard_disk_equation_of_state(packing):
-    """Periodic fluid, no walls: Z from the collision virial matches Henderson's equation of state
-    (itself within 0.03% of the virial series at these packings)."""
+    """Periodic fluid, no walls: Z from the collision virial matches Henderson's equation of state,
+    within the statistical error plus Henderson's own error (its distance from the virial
+    series, whose omitted terms are smaller still here)."""
     thermo = measure(hard_disk_fluid(packing), 500.0)
     assert thermo.area == pytest.approx(900 * np.pi * 0.25 / packing)
     z = thermo.compressibility()
     error = thermo.virial_pressure_error() * thermo.area / (thermo.n * thermo.temperature)
     assert error < 1e-3 * z
-    assert abs(z - hard_disk_compressibility(packing)) < 3 * error + 3e-4 * z
+    henderson = hard_disk_compressibility(packing)
+    series = 1 + sum(b * packing ** (k + 1) for k, b in enumerate(VIRIAL_SERIES))
+    assert abs(z - henderson) < 3 * error + abs(henderson - series)
     assert np.isnan(thermo.wall_pressure()["total"])
 
 

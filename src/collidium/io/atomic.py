@@ -22,9 +22,11 @@ def replacing(path: str | Path) -> Iterator[Path]:
     Raises
     ------
     InputError
-        If the folder does not exist or cannot be written.
+        If ``path`` names a folder, or its folder does not exist or cannot be written.
     """
     path = Path(path)
+    if not path.name or path.is_dir():
+        raise InputError(str(path), "is a folder; give a file name")
     temporary = path.with_name(f".{path.stem}.{secrets.token_hex(4)}.part{path.suffix}")
     try:
         with temporary.open("xb"):

@@ -54,7 +54,10 @@ def read_checkpoint(path: str | Path) -> tuple[dict[str, np.ndarray], dict[str, 
     try:
         with np.load(path, allow_pickle=False) as archive:
             arrays = {name: archive[name] for name in archive.files}
-        meta = json.loads(arrays.pop(_META).tobytes().decode("utf-8"))
+        header = arrays.pop(_META)
+        if not isinstance(header, np.ndarray):
+            raise ValueError("its header is not an array")
+        meta = json.loads(header.tobytes().decode("utf-8"))
     except (zipfile.BadZipFile, KeyError, ValueError, OSError, EOFError, UnicodeError) as exc:
         raise InputError(str(path), f"not a readable collidium checkpoint ({exc})") from None
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:

@@ -106,10 +106,16 @@ class GSDWriter:
     trigger : callable or int, optional
         When to write (default every step). The state when the run starts is written too.
     flush_seconds : float
-        Frames are flushed to disk at most this many wall-clock seconds apart (and when the
-        writer is closed); 0 flushes every frame. A killed run keeps every flushed frame.
+        Every frame reaches the disk within this many wall-clock seconds (checked after each
+        step), and all of them when the writer is closed; 0 flushes each frame as it is written.
+        A killed run keeps every flushed frame.
     append : bool
         Add to an existing file instead of replacing it (used when a run resumes).
+
+    Notes
+    -----
+    A closed writer reopens its file (appending) at its next frame, so it can stay attached
+    across runs.
     """
 
     def __init__(
@@ -120,56 +126,72 @@ class GSDWriter:
         append: bool = False,
     ) -> None:
         self.path = Path(path)
-        self.trigger = as_trigger(trigger)
+        self._frames = as_trigger(trigger)
         if not flush_seconds >= 0:
             raise InputError("flush_seconds", f"must be >= 0, got {flush_seconds!r}")
         self.flush_seconds = float(flush_seconds)
         self.append = append
         self._file: gsd.hoomd.HOOMDTrajectory | None = None
-        self._last_flush = 0.0
+        self._unflushed_since: float | None = None  # when the oldest unflushed frame was written
         self._last_step = -1
         self.frames_written = 0
+        #: What the run loop calls after each step: the frame trigger, with the flush check.
+        self.trigger: Trigger = self._flush_when_due_then_trigger
+
+    def _flush_when_due_then_trigger(self, sim: Simulation) -> bool:
+        """Flush frames that have waited ``flush_seconds``; then ask the frame trigger."""
+        waiting = self._unflushed_since
+        if waiting is not None and clock.monotonic() - waiting >= self.flush_seconds:
+            self.flush()
+        return self._frames(sim)
 
     def attach(self, sim: Simulation) -> None:
         """Open the file and write the current state as the first frame (when appending to a
         file that has frames, only the trigger's frames are added)."""
+        if self._open():
+            self.update(sim)
+
+    def _open(self) -> bool:
+        """Open the file if closed; False if it already holds frames to continue."""
         import gsd.hoomd
 
-        if self._file is None:
-            try:
-                self._file = gsd.hoomd.open(self.path, "r+" if self.append else "w")
-            except (OSError, RuntimeError) as exc:
-                raise InputError(str(self.path), f"cannot write a GSD file: {exc}") from None
-            self._last_flush = clock.monotonic()
-            if self.append and len(self._file):
-                self._last_step = int(self._file[-1].configuration.step)
-                return
-        self.update(sim)
+        if self._file is not None:
+            return True
+        try:
+            self._file = gsd.hoomd.open(self.path, "r+" if self.append else "w")
+        except (OSError, RuntimeError) as exc:
+            raise InputError(str(self.path), f"cannot write a GSD file: {exc}") from None
+        if self.append and len(self._file):
+            self._last_step = int(self._file[-1].configuration.step)
+            return False
+        return True
 
     def update(self, sim: Simulation) -> None:
-        """Append the current state (once per step) and flush when due."""
+        """Append the current state (once per step); flush at once if ``flush_seconds`` is 0."""
+        self._open()
         if self._file is None or sim.steps == self._last_step:
             return
         self._file.append(frame_of(sim))
         self._last_step = sim.steps
         self.frames_written += 1
-        now = clock.monotonic()
-        if now - self._last_flush >= self.flush_seconds:
-            self._file.flush()
-            self._last_flush = now
+        if self._unflushed_since is None:
+            self._unflushed_since = clock.monotonic()
+        if self.flush_seconds == 0:
+            self.flush()
 
     def flush(self) -> None:
         """Write the buffered frames to disk now."""
         if self._file is not None:
             self._file.flush()
-            self._last_flush = clock.monotonic()
+        self._unflushed_since = None
 
     def close(self) -> None:
-        """Flush and close the file (the writer can be attached again to reopen it)."""
+        """Flush and close the file."""
         if self._file is not None:
             self._file.close()
             self._file = None
             self.append = True  # reopening continues the same file
+        self._unflushed_since = None
 
     def __enter__(self) -> GSDWriter:
         return self
@@ -292,9 +314,11 @@ def keep_frames_through(path: str | Path, step: int) -> int:
     there); returns how many frames remain. The file is replaced atomically."""
     import gsd.hoomd
 
-    kept = [f for f in iter_frames(path) if int(f.configuration.step) <= step]
-    with replacing(path) as temporary, gsd.hoomd.open(temporary, "w") as out:
-        out.extend(kept)
+    frames = list(iter_frames(path))
+    kept = [f for f in frames if int(f.configuration.step) <= step]
+    if len(kept) < len(frames):
+        with replacing(path) as temporary, gsd.hoomd.open(temporary, "w") as out:
+            out.extend(kept)
     return len(kept)
 
 

@@ -145,17 +145,23 @@ class EnergyDrift(Measurement):
     ----------
     trigger : callable or int, optional
         When to sample (default every step).
+    reference : float, optional
+        Energy to measure the drift from, J (default: the first sample's); a resumed run passes
+        the energy at the start of the whole run.
 
     Attributes
     ----------
     initial_total : float
-        Total energy in J at the first sample.
+        The reference energy in J.
     max_rel_drift : float
-        ``max |E(t) - E(0)| / |E(0)|`` over the samples.
+        ``max |E(t) - E_ref| / |E_ref|`` over the samples.
     """
 
-    def __init__(self, trigger: Trigger | int | None = None) -> None:
+    def __init__(
+        self, trigger: Trigger | int | None = None, reference: float | None = None
+    ) -> None:
         super().__init__(trigger)
+        self.reference = reference
         self.initial_total = float("nan")
         self.max_rel_drift = 0.0
 
@@ -165,14 +171,14 @@ class EnergyDrift(Measurement):
         return not np.isnan(self.initial_total)
 
     def compute(self, sim: Simulation, reset: bool = True) -> Self:
-        """Start afresh from the current energy, or (``reset=False``) fold it into the maximum."""
+        """Start afresh from the current energy (or the reference), or (``reset=False``) fold
+        the current energy into the maximum."""
         total = sim.energy().total
         if reset or not self.sampled:
-            self.initial_total = total
+            self.initial_total = total if self.reference is None else self.reference
             self.max_rel_drift = 0.0
-        else:
-            drift = abs(total - self.initial_total) / max(abs(self.initial_total), 1e-300)
-            self.max_rel_drift = max(self.max_rel_drift, drift)
+        drift = abs(total - self.initial_total) / max(abs(self.initial_total), 1e-300)
+        self.max_rel_drift = max(self.max_rel_drift, drift)
         return self
 
     def summary(self) -> dict[str, Any]:

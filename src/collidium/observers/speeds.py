@@ -34,9 +34,9 @@ class SpeedHistogram(Measurement):
     Notes
     -----
     The temperature is the mean of ``KE / N`` over the samples (2 degrees of freedom, k = 1).
-    `ks` tests the pooled speeds against the Maxwell-Boltzmann law at that temperature (a
-    mass-weighted mixture when masses differ); speeds from snapshots close in time are correlated,
-    so for a time average its p-value is only indicative.
+    `ks` tests the pooled speeds against the Maxwell-Boltzmann law at that temperature (when
+    masses differ, a mixture weighted by the number of particles of each mass); speeds from
+    snapshots close in time are correlated, so for a time average its p-value is only indicative.
     """
 
     #: Snapshots are taken when the trigger fires only (not when the run starts).

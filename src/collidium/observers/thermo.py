@@ -168,6 +168,8 @@ class Thermo(Measurement):
         """Block averages of the wall and virial pressures over time, with the ideal-gas value."""
         ax = new_axes(ax)
         time = np.asarray(self._time)[1:]
+        if time.size == 0:  # one sample: no interval to average over yet
+            return ax
         middle, _ = _blocks(time, np.ones_like(time))
         if not self.periodic:
             ax.plot(middle, _blocks(*self._wall_values())[0], "o-", label="wall")
