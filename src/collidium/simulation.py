@@ -249,7 +249,12 @@ class Simulation:
 
     def temperature(self) -> float:
         """kT = KE / N in J (2 degrees of freedom per particle, Boltzmann's constant 1); NaN
-        for an empty vessel."""
+        for an empty vessel.
+
+        The centre-of-mass motion is included: with walls momentum is not conserved and it is
+        part of the thermal motion; in a periodic box, where momentum is conserved, the
+        equipartition value ``(KE - P^2 / 2M) / (N - 1)`` differs from it by order 1/N.
+        """
         n = self.particles.n
         return self.energy().kinetic / n if n else float("nan")
 
