@@ -343,3 +343,25 @@ def test_truncated_files_give_one_line_on_every_command(tmp_path, kind):
         assert result.stderr.startswith(f"error: {path.name}: ") and result.stderr.count("\n") == 1
         assert "Traceback" not in result.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+
+
+def test_movie_without_ffmpeg_falls_back_to_gif_with_a_one_line_warning(tmp_path, capsys):
+    import sys as system
+
+    from collidium.cli import main
+
+    saved = system.modules.get("imageio_ffmpeg")
+    system.modules["imageio_ffmpeg"] = None  # type: ignore[assignment]
+    try:
+        code = main(["render", "head-on", "--time", "0.2", "--every", "5", "--movie",
+                     str(tmp_path / "m.mp4")])  # fmt: skip
+    finally:
+        if saved is not None:
+            system.modules["imageio_ffmpeg"] = saved
+        else:
+            del system.modules["imageio_ffmpeg"]
+    captured = capsys.readouterr()
+    assert code == 0
+    assert captured.out.strip() == str(tmp_path / "m.gif")
+    (line,) = captured.err.splitlines()
+    assert line.startswith("warning: imageio-ffmpeg is not installed") and "[movie]" in line

@@ -11,6 +11,7 @@ import json
 import sys
 import tempfile
 import tomllib
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
@@ -190,7 +191,12 @@ def render_command(
         for path in render.write_plots(trajectory, plots):
             typer.echo(str(path))
     if movie is not None:
-        typer.echo(str(render.write_movie(trajectory, movie, fps=fps, progress=show)))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            written = render.write_movie(trajectory, movie, fps=fps, progress=show)
+        for warning in caught:  # one line each, not Python's two-line format
+            sys.stderr.write(f"warning: {warning.message}\n")
+        typer.echo(str(written))
 
 
 def _trajectory_of(
