@@ -143,6 +143,8 @@ class Measurement:
 
     def __init__(self, trigger: Trigger | int | None = None) -> None:
         self.trigger: Trigger = as_trigger(trigger)
+        #: Samples taken since the last reset.
+        self.samples = 0
 
     def attach(self, sim: Simulation) -> None:
         """Take the first sample when a run starts, unless samples were taken already or the
@@ -158,10 +160,24 @@ class Measurement:
     @property
     def sampled(self) -> bool:
         """True once at least one sample was taken."""
-        raise NotImplementedError
+        return self.samples > 0
 
     def compute(self, sim: Simulation, reset: bool = True) -> Self:
-        """Sample the simulation; ``reset=False`` adds to the samples taken so far."""
+        """Sample the simulation; ``reset=False`` adds to the samples taken so far (the first
+        sample always starts afresh)."""
+        if reset or not self.sampled:
+            self.samples = 0
+            self._start(sim)
+        self._sample(sim)
+        self.samples += 1
+        return self
+
+    def _start(self, sim: Simulation) -> None:
+        """Forget earlier samples; note what stays fixed over a window."""
+        raise NotImplementedError
+
+    def _sample(self, sim: Simulation) -> None:
+        """Take one sample."""
         raise NotImplementedError
 
     def plot(self, ax: Axes | None = None) -> Axes:

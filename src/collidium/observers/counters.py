@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Self
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -31,20 +31,14 @@ class CollisionRate(Measurement):
         self._counts: list[np.ndarray] = []
         self._mean_speed: list[float] = []
 
-    @property
-    def sampled(self) -> bool:
-        """True once a sample was taken."""
-        return bool(self._time)
+    def _start(self, sim: Simulation) -> None:
+        self._time, self._counts, self._mean_speed = [], [], []
+        self.n = sim.particles.n
 
-    def compute(self, sim: Simulation, reset: bool = True) -> Self:
-        """Sample the counters; ``reset=False`` extends the window to now."""
-        if reset:
-            self._time, self._counts, self._mean_speed = [], [], []
-            self.n = sim.particles.n
+    def _sample(self, sim: Simulation) -> None:
         self._time.append(sim.time)
         self._counts.append(sim.tally.counts.copy())
         self._mean_speed.append(sim.total_speed() / max(sim.particles.n, 1))
-        return self
 
     @property
     def time(self) -> FloatArray:

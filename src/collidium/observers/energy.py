@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Self
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -41,19 +41,13 @@ class EnergySeries(Measurement):
         super().__init__(trigger)
         self._rows: list[tuple[float, ...]] = []
 
-    @property
-    def sampled(self) -> bool:
-        """True once a sample was taken."""
-        return bool(self._rows)
+    def _start(self, sim: Simulation) -> None:
+        self._rows = []
 
-    def compute(self, sim: Simulation, reset: bool = True) -> Self:
-        """Sample the energies of ``sim``; ``reset=False`` appends to the series."""
-        if reset:
-            self._rows = []
+    def _sample(self, sim: Simulation) -> None:
         e = sim.energy()
         px, py = sim.momentum()
         self._rows.append((sim.time, e.kinetic, e.potential, sim.total_speed(), px, py))
-        return self
 
     def _column(self, name: str) -> FloatArray:
         table = np.asarray(self._rows, dtype=float).reshape(-1, len(_COLUMNS))
@@ -165,21 +159,14 @@ class EnergyDrift(Measurement):
         self.initial_total = float("nan")
         self.max_rel_drift = 0.0
 
-    @property
-    def sampled(self) -> bool:
-        """True once the starting energy is known."""
-        return not np.isnan(self.initial_total)
+    def _start(self, sim: Simulation) -> None:
+        """Measure from the current energy (or the reference)."""
+        self.initial_total = sim.energy().total if self.reference is None else self.reference
+        self.max_rel_drift = 0.0
 
-    def compute(self, sim: Simulation, reset: bool = True) -> Self:
-        """Start afresh from the current energy (or the reference), or (``reset=False``) fold
-        the current energy into the maximum."""
-        total = sim.energy().total
-        if reset or not self.sampled:
-            self.initial_total = total if self.reference is None else self.reference
-            self.max_rel_drift = 0.0
-        drift = abs(total - self.initial_total) / max(abs(self.initial_total), 1e-300)
+    def _sample(self, sim: Simulation) -> None:
+        drift = abs(sim.energy().total - self.initial_total) / max(abs(self.initial_total), 1e-300)
         self.max_rel_drift = max(self.max_rel_drift, drift)
-        return self
 
     def summary(self) -> dict[str, Any]:
         """Initial total energy and largest relative drift."""

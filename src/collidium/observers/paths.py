@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any, Self
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -43,25 +43,19 @@ class Tracer(Measurement):
         self._time: list[float] = []
         self._path: list[FloatArray] = []
 
-    @property
-    def sampled(self) -> bool:
-        """True once a sample was taken."""
-        return bool(self._time)
-
-    def compute(self, sim: Simulation, reset: bool = True) -> Self:
-        """Record the followed particles' positions; ``reset=False`` extends the paths."""
+    def _start(self, sim: Simulation) -> None:
         if (
             self.indices is not None
             and self.indices.size
             and (self.indices.min() < 0 or self.indices.max() >= sim.particles.n)
         ):
             raise InputError("particles", f"indices must lie in [0, {sim.particles.n})")
-        if reset:
-            self._time, self._path = [], []
+        self._time, self._path = [], []
+
+    def _sample(self, sim: Simulation) -> None:
         position = sim.unwrapped_position()
         self._time.append(sim.time)
         self._path.append(position if self.indices is None else position[self.indices])
-        return self
 
     @property
     def time(self) -> FloatArray:

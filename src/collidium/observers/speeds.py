@@ -60,27 +60,26 @@ class SpeedHistogram(Measurement):
         self._masses: list[FloatArray] = []
         self._temperatures: list[float] = []
 
-    @property
-    def sampled(self) -> bool:
-        """True once a snapshot was taken."""
-        return bool(self._speeds)
+    def _start(self, sim: Simulation) -> None:
+        self.counts[:] = 0
+        self._speeds, self._masses, self._temperatures = [], [], []
 
-    def compute(self, sim: Simulation, reset: bool = True) -> Self:
-        """Histogram the current speeds; ``reset=False`` adds them to the earlier snapshots."""
-        if reset:
-            self.counts[:] = 0
-            self._speeds, self._masses, self._temperatures = [], [], []
+    def _sample(self, sim: Simulation) -> None:
         p = sim.particles
-        return self.add(np.hypot(p.velocity[:, 0], p.velocity[:, 1]), p.mass, sim.temperature())
+        self._add(np.hypot(p.velocity[:, 0], p.velocity[:, 1]), p.mass, sim.temperature())
 
     def add(self, speed: FloatArray, mass: FloatArray, kT: float) -> Self:
         """Add one snapshot given as arrays: speeds (N,) in m/s, masses (N,) in kg and its
         temperature kT in J (for snapshots read from a file)."""
+        self._add(speed, mass, kT)
+        self.samples += 1
+        return self
+
+    def _add(self, speed: FloatArray, mass: FloatArray, kT: float) -> None:
         self.counts += np.histogram(speed, self.bin_edges)[0]
         self._speeds.append(np.asarray(speed, dtype=float))
         self._masses.append(np.array(mass, dtype=float))
         self._temperatures.append(float(kT))
-        return self
 
     @property
     def frames(self) -> int:

@@ -14,7 +14,7 @@ virial theorem with the walls' forces included), and an ideal gas has ``P A_c = 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Self
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -70,29 +70,23 @@ class Thermo(Measurement):
         self._impulse: list[FloatArray] = []
         self._force_virial: list[float] = []
 
-    @property
-    def sampled(self) -> bool:
-        """True once a sample was taken."""
-        return bool(self._time)
+    def _start(self, sim: Simulation) -> None:
+        self._time, self._kT, self._impulse, self._force_virial = [], [], [], []
+        self.n = sim.particles.n
+        box = sim.container
+        walled = not box.periodic and self.n > 0
+        inset = 2.0 * float(np.mean(sim.particles.radius)) if walled else 0.0
+        self.periodic = box.periodic
+        #: Lengths (m) of the lines of contact of the left/right and of the bottom/top walls.
+        self.contact = (box.height - inset, box.width - inset)
+        #: Area (m^2) the centres move in.
+        self.area = (box.width - inset) * (box.height - inset)
 
-    def compute(self, sim: Simulation, reset: bool = True) -> Self:
-        """Sample the state; ``reset=False`` extends the averaging window to now."""
-        if reset:
-            self._time, self._kT, self._impulse, self._force_virial = [], [], [], []
-            self.n = sim.particles.n
-            box = sim.container
-            walled = not box.periodic and self.n > 0
-            inset = 2.0 * float(np.mean(sim.particles.radius)) if walled else 0.0
-            self.periodic = box.periodic
-            #: Lengths (m) of the lines of contact of the left/right and of the bottom/top walls.
-            self.contact = (box.height - inset, box.width - inset)
-            #: Area (m^2) the centres move in.
-            self.area = (box.width - inset) * (box.height - inset)
+    def _sample(self, sim: Simulation) -> None:
         self._time.append(sim.time)
         self._kT.append(sim.temperature())
         self._impulse.append(sim.tally.impulse.copy())
         self._force_virial.append(sim.virial())
-        return self
 
     def _intervals(self) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """Per sampled interval: duration, impulse sums gained, kT and force virial at its end."""
