@@ -1,4 +1,4 @@
-"""The ``collidium`` command line: presets, run, resume, export, inspect, convert, render.
+"""The ``collidium`` command line: presets, run, resume, export, inspect, convert, render, view.
 
 Bad input of any kind prints one line ``error: <field>: <reason>`` on stderr and exits with
 status 2 (no traceback, nothing half-written); a run that goes wrong exits with status 1.
@@ -195,7 +195,7 @@ def render_command(
             warnings.simplefilter("always")
             written = render.write_movie(trajectory, movie, fps=fps, progress=show)
         for warning in caught:  # one line each, not Python's two-line format
-            sys.stderr.write(f"warning: {warning.message}\n")
+            _warn(str(warning.message))
         typer.echo(str(written))
 
 
@@ -244,6 +244,54 @@ def export_command(
         sys.stdout.write(text)
     else:
         write_atomically(output, text)
+
+
+@app.command("view")
+def view_command(
+    scenario: Annotated[
+        str, typer.Argument(help="Preset name or scenario .toml file (default: gas).")
+    ] = "gas",
+    overrides: SetOption = None,
+    host: Annotated[
+        str,
+        typer.Option("--host", help="Address to listen on; only this machine by default."),
+    ] = "127.0.0.1",
+    port: Annotated[int, typer.Option("--port", help="Port (0: any free one).")] = 8765,
+    browser: Annotated[
+        bool, typer.Option("--browser/--no-browser", help="Open the page in a web browser.")
+    ] = True,
+) -> None:
+    """Watch and steer a simulation live in the browser (until Ctrl+C)."""
+    from collidium.loading import load_scenario
+    from collidium.presets import PRESETS
+    from collidium.viewer.server import LOOPBACK, bind, check_built, create_app, serve, url_of
+    from collidium.viewer.session import ViewerSession
+
+    check_built()
+    if not 0 <= port <= 65535:
+        raise InputError("--port", f"must be in [0, 65535], got {port}")
+    values = parse_settings(overrides or [])
+    spec = load_scenario(scenario, **values)
+    if spec.observers:
+        _warn(f"the viewer measures by itself; the [[observers]] of {scenario} are not run")
+        spec = spec.model_copy(update={"observers": []})
+    name = scenario if scenario in PRESETS else None
+    shown = {k: v for k, v in values.items() if "." not in k} if name else {}
+    ViewerSession(spec, preset=name, overrides=shown)  # refuse a bad scenario before listening
+    if host not in LOOPBACK:
+        _warn(f"--host {host} lets every machine that reaches this one run and steer simulations")
+    sock = bind(host, port)
+    url = url_of(sock, host)
+    sys.stderr.write(f"collidium viewer at {url} (Ctrl+C to stop)\n")
+    if browser:
+        import webbrowser
+
+        webbrowser.open(url)
+    serve(create_app(lambda: ViewerSession(spec, preset=name, overrides=shown)), sock)
+
+
+def _warn(line: str) -> None:
+    sys.stderr.write(f"warning: {line}\n")
 
 
 def parse_settings(items: Sequence[str]) -> dict[str, Any]:
@@ -354,7 +402,7 @@ def _usage_line(exc: Exception) -> str:
     return f"{field}: {message[0].lower()}{message[1:]}"
 
 
-_COMMANDS = ("presets", "run", "resume", "export", "inspect", "convert", "render")
+_COMMANDS = ("presets", "run", "resume", "export", "inspect", "convert", "render", "view")
 
 
 def _fail(line: str, code: int) -> int:

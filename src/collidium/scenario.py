@@ -76,7 +76,7 @@ from collidium.observers import (
     Trigger,
 )
 from collidium.simulation import Simulation, outside_detail, overlap_detail
-from collidium.state import FloatArray, Particles
+from collidium.state import FloatArray, Particles, uniform_or_each
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -333,6 +333,11 @@ class ExplicitGroup(_Model):
             raise ValueError(f"has {len(value)} entries but position has {len(position)}")
         return value
 
+    @property
+    def count(self) -> int:
+        """Number of particles in the group."""
+        return len(self.position)
+
     def generate(
         self, rng: np.random.Generator, box: Box, existing: GroupState, index: int
     ) -> GroupState:
@@ -362,6 +367,11 @@ class RandomGroup(_Model):
     speed: NonNegative = 0.0
     charge: Finite = 0.0
     charges: Literal["same", "balanced"] = "same"
+
+    @property
+    def count(self) -> int:
+        """Number of particles in the group."""
+        return self.n
 
     def generate(
         self, rng: np.random.Generator, box: Box, existing: GroupState, index: int
@@ -396,6 +406,11 @@ class RackGroup(_Model):
     gap: NonNegative = 0.01
     charge: Finite = 0.0
     back_tip: bool = False
+
+    @property
+    def count(self) -> int:
+        """Number of particles in the group: ``rows^2 - 1``, plus one with ``back_tip``."""
+        return self.rows**2 - 1 + int(self.back_tip)
 
     def generate(
         self, rng: np.random.Generator, box: Box, existing: GroupState, index: int
@@ -513,6 +528,38 @@ class Scenario(_Model):
     def with_overrides(self, overrides: Mapping[str, Any]) -> Scenario:
         """A copy with dotted-path overrides applied, validated again (see `apply_overrides`)."""
         return Scenario.from_dict(apply_overrides(self.to_dict(), overrides))
+
+    @property
+    def particle_count(self) -> int:
+        """Number of particles the scenario builds (known before building)."""
+        return sum(group.count for group in self.particles)
+
+    @classmethod
+    def of_state(cls, sim: Simulation, name: str | None = None) -> Scenario:
+        """A scenario that builds ``sim``'s current state: its vessel, run settings and forces,
+        and its particles as one explicit group (positions wrapped into a periodic box)."""
+        p = sim.particles
+        box = sim.container
+        return cls.from_dict(
+            {
+                "name": name or sim.name,
+                "description": f"the state of {sim.name} at t = {sim.time:.6g} s",
+                "seed": sim.seed or 0,
+                "box": {"width": box.width, "height": box.height, "boundary": box.boundary},
+                "run": {"dt": sim.dt, "collisions": sim.collisions},
+                "forces": [force.to_dict() for force in sim.forces],
+                "particles": [
+                    {
+                        "kind": "explicit",
+                        "position": p.position,
+                        "velocity": p.velocity,
+                        "mass": uniform_or_each(p.mass),
+                        "radius": uniform_or_each(p.radius),
+                        "charge": uniform_or_each(p.charge),
+                    }
+                ],
+            }
+        )
 
     def initial_state(self) -> tuple[Box, Particles, list[int]]:
         """Generate the vessel and the particles.

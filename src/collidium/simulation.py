@@ -157,13 +157,29 @@ class Simulation:
 
     @property
     def collisions(self) -> CollisionMode:
-        """Collision mode, fixed at construction: "exact", "step" or "off"."""
+        """Collision mode: "exact", "step" or "off"; may be changed between runs.
+
+        Disks that came to overlap while collisions were off separate again under "exact"
+        (approaching overlapping pairs collide at once) and under "step".
+        """
         return self._collisions
+
+    @collisions.setter
+    def collisions(self, mode: CollisionMode) -> None:
+        _check_mode(mode)
+        if mode != self._collisions:
+            self._collisions = mode
+            self._drift = make_drift(mode)
 
     @property
     def forces(self) -> tuple[Coulomb, ...]:
-        """The forces acting."""
+        """The forces acting; may be replaced between runs (an empty sequence for none)."""
         return self._field.forces
+
+    @forces.setter
+    def forces(self, forces: Sequence[Coulomb]) -> None:
+        _check_forces(forces)
+        self._field = ForceField(tuple(forces))
 
     def run(
         self, time: float | None = None, steps: int | None = None, progress: bool = False
@@ -414,13 +430,21 @@ def _check_setup(
         raise InputError("container", f"must be a Box, got {type(container).__name__}")
     if not isinstance(particles, Particles):
         raise InputError("particles", f"must be Particles, got {type(particles).__name__}")
+    _check_forces(forces)
+    _check_dt(dt)
+    _check_mode(collisions)
+    container.check_fits(particles.radius)
+
+
+def _check_forces(forces: Sequence[Coulomb]) -> None:
     for k, force in enumerate(forces):
         if not isinstance(force, Coulomb):
             raise InputError(f"forces.{k}", f"unknown force {type(force).__name__}")
-    _check_dt(dt)
+
+
+def _check_mode(collisions: str) -> None:
     if collisions not in COLLISION_MODES:
         raise InputError("collisions", f"must be one of {COLLISION_MODES}, got {collisions!r}")
-    container.check_fits(particles.radius)
 
 
 def _check_dt(dt: float) -> None:

@@ -122,3 +122,9 @@ class Particles:
             charge=self.charge.copy(),
             image=self.image.copy(),
         )
+
+
+def uniform_or_each(values: FloatArray) -> float | FloatArray:
+    """One value when every particle has the same, else the per-particle array (for compact
+    files and messages)."""
+    return float(values[0]) if values.size and (values == values[0]).all() else values

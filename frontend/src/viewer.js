@@ -1,0 +1,355 @@
+// The live viewer: builds the UI inside a root element and connects it to a transport (page
+// WebSocket or Jupyter widget). Frames are drawn from requestAnimationFrame, newest first, and
+// every received frame is acknowledged there, which is the server's backpressure.
+import { createControls, saveTextFile } from "./controls.js";
+import { createDiskRenderer, perParticle } from "./disks.js";
+import { element } from "./dom.js";
+import { decodeFrame } from "./frame.js";
+import { createViewport } from "./geometry.js";
+import { createMessageBar } from "./message.js";
+import { createOverlay } from "./overlay.js";
+import { createEnergyPlot, createSpeedPlot } from "./plots.js";
+import { attachPointer } from "./pointer.js";
+import { createReadouts } from "./readouts.js";
+import { createTracePath } from "./trace.js";
+
+/** Extra reach, in CSS pixels, around a disk when clicking on it. */
+const PICK_SLACK_PX = 3;
+
+/** The static DOM: vessel (WebGL canvas + overlay), plots, readouts, controls, message bar. */
+function buildLayout(root) {
+  const particles = element("canvas", { id: "particles" });
+  const overlay = element("canvas", { id: "overlay" });
+  const vessel = element("div", { id: "vessel" }, [particles, overlay]);
+  const energy = element("div", { id: "energy-plot", className: "plot" });
+  const speed = element("div", { id: "speed-plot", className: "plot" });
+  const readouts = element("div", { className: "collidium-readouts" });
+  const controls = element("div", { className: "collidium-controls" });
+  const message = element("div", { id: "message", role: "status", text: "connecting…" });
+  root.classList.add("collidium");
+  root.replaceChildren(
+    vessel,
+    element("div", { className: "collidium-plots" }, [energy, speed]),
+    readouts,
+    controls,
+    message,
+  );
+  return { vessel, particles, overlay, energy, speed, readouts, controls, message };
+}
+
+function describeScene(scene) {
+  const box = scene.box ?? {};
+  return `${scene.name}: ${scene.n} particles in a ${box.width} × ${box.height} m ${box.boundary ?? ""} box`;
+}
+
+/** Mounts the viewer in `root`; returns `{ destroy(), hooks }` (hooks: the test hook object). */
+export function mountViewer(root, transport) {
+  const layout = buildLayout(root);
+  const viewport = createViewport();
+  const renderer = createDiskRenderer(layout.particles, viewport);
+  const overlay = createOverlay(layout.overlay, viewport);
+  const energyPlot = createEnergyPlot(layout.energy);
+  const speedPlot = createSpeedPlot(layout.speed);
+  const messageBar = createMessageBar(layout.message);
+  const readouts = createReadouts(layout.readouts);
+  const trace = createTracePath();
+  const send = (message) => transport.send(message);
+  const report = (field, reason) => messageBar.error(field ? `${field}: ${reason}` : reason);
+  const controls = createControls(layout.controls, { send, report });
+
+  const state = {
+    connected: false,
+    destroyed: false,
+    stopped: false,
+    scene: null,
+    status: null,
+    stats: null,
+    lastError: null,
+    radii: new Float32Array(0),
+    framesReceived: 0,
+    framesDrawn: 0,
+    pendingFrame: null, // newest accepted frame not drawn yet
+    drawnFrame: null, // the frame on screen (used for picking and dragging)
+    pendingAcks: [],
+    drag: null, // {index, pointer: [x, y] in metres}
+    needsRedraw: false,
+    overlayDirty: false,
+    rafId: 0,
+    warnedSize: false,
+  };
+
+  // --- rendering ------------------------------------------------------------------------------
+
+  function requestRender() {
+    if (!state.rafId && !state.stopped) state.rafId = requestAnimationFrame(renderTick);
+  }
+
+  /** One animation frame: draw the newest frame (if any), the overlay if needed, then ack. */
+  function renderTick() {
+    state.rafId = 0;
+    if (state.stopped) return;
+    const frame = state.pendingFrame;
+    if (frame) {
+      state.pendingFrame = null;
+      state.drawnFrame = frame;
+      renderer.setFrame(frame);
+      state.framesDrawn += 1;
+      state.needsRedraw = true;
+      if (trace.index !== null || state.drag) state.overlayDirty = true;
+    }
+    redraw();
+    for (const seq of state.pendingAcks) send({ type: "ack", frame: seq });
+    state.pendingAcks.length = 0;
+  }
+
+  function redraw() {
+    if (state.needsRedraw) renderer.draw();
+    if (state.overlayDirty) drawOverlay();
+    state.needsRedraw = false;
+    state.overlayDirty = false;
+  }
+
+  function particleAt(index) {
+    const frame = state.drawnFrame;
+    if (!frame || index === null || index >= frame.n) return null;
+    return [frame.positions[2 * index], frame.positions[2 * index + 1]];
+  }
+
+  function drawOverlay() {
+    const traced = particleAt(trace.index);
+    const tracedAt = traced && { x: traced[0], y: traced[1], radius: state.radii[trace.index] ?? 0 };
+    const dragFrom = state.drag && particleAt(state.drag.index);
+    const drag = dragFrom && { from: dragFrom, to: state.drag.pointer };
+    overlay.draw({ trace, tracedAt, drag });
+  }
+
+  /** Matches both canvases to the vessel's size in device pixels and redraws at once. */
+  function resizeVessel() {
+    if (state.destroyed) return;
+    const width = layout.vessel.clientWidth;
+    const height = layout.vessel.clientHeight;
+    const dpr = window.devicePixelRatio || 1;
+    for (const canvas of [layout.particles, layout.overlay]) {
+      canvas.width = Math.max(1, Math.round(width * dpr));
+      canvas.height = Math.max(1, Math.round(height * dpr));
+    }
+    viewport.setCanvasSize(width, height, dpr);
+    state.needsRedraw = true;
+    state.overlayDirty = true;
+    redraw(); // now, not next frame: resizing cleared the canvases
+  }
+
+  // --- frames ---------------------------------------------------------------------------------
+
+  function receiveFrame(buffer) {
+    state.framesReceived += 1;
+    const frame = decodeFrame(buffer);
+    if (frame.seq !== null) state.pendingAcks.push(frame.seq);
+    if (!frame.ok) console.warn(`collidium: ignoring a frame (${frame.reason})`);
+    else if (belongsToScene(frame)) acceptFrame(frame);
+    requestRender();
+  }
+
+  /** Frames of an older scene are dropped (still acknowledged); so is one of the wrong size. */
+  function belongsToScene(frame) {
+    const scene = state.scene;
+    if (!scene || frame.generation !== scene.generation) return false;
+    if (frame.n === scene.n) return true;
+    if (!state.warnedSize) console.warn(`collidium: frame has ${frame.n} particles, scene has ${scene.n}`);
+    state.warnedSize = true;
+    return false;
+  }
+
+  function acceptFrame(frame) {
+    state.pendingFrame = frame;
+    const index = trace.index;
+    if (index !== null && index < frame.n) trace.push(frame.positions[2 * index], frame.positions[2 * index + 1]);
+  }
+
+  // --- pointer: trace and drag ----------------------------------------------------------------
+
+  /** The particle whose centre is nearest (cssX, cssY) within its radius + a few pixels. */
+  function pick(cssX, cssY) {
+    const frame = state.drawnFrame;
+    if (!frame) return null;
+    const [x, y] = viewport.cssToWorld(cssX, cssY);
+    const slack = PICK_SLACK_PX / viewport.pixelsPerMetre;
+    const positions = frame.positions;
+    let best = null;
+    let bestDistance = Infinity;
+    for (let i = 0; i < frame.n; i += 1) {
+      const distance = Math.hypot(positions[2 * i] - x, positions[2 * i + 1] - y);
+      if (distance <= state.radii[i] + slack && distance < bestDistance) {
+        best = i;
+        bestDistance = distance;
+      }
+    }
+    return best;
+  }
+
+  const detachPointer = attachPointer(layout.overlay, pick, {
+    onClick(index) {
+      send({ type: "trace", index });
+    },
+    onDrag(index, cssX, cssY) {
+      state.drag = { index, pointer: viewport.cssToWorld(cssX, cssY) };
+      state.overlayDirty = true;
+      requestRender();
+    },
+    onDrop(index, cssX, cssY) {
+      const centre = particleAt(index);
+      const [x, y] = viewport.cssToWorld(cssX, cssY);
+      // The displacement in metres is read as the new velocity in m/s.
+      if (centre) send({ type: "set_velocity", index, vx: x - centre[0], vy: y - centre[1] });
+      state.drag = null;
+      state.overlayDirty = true;
+      requestRender();
+    },
+    onCancel() {
+      state.drag = null;
+      state.overlayDirty = true;
+      requestRender();
+    },
+  });
+
+  // --- messages -------------------------------------------------------------------------------
+
+  function applyScene(scene) {
+    state.scene = scene;
+    state.stats = null;
+    state.radii = perParticle(scene.radius, scene.n | 0, 0);
+    state.pendingFrame = null;
+    state.drawnFrame = null;
+    state.drag = null;
+    state.warnedSize = false;
+    viewport.setBox(scene.box?.width, scene.box?.height);
+    renderer.setScene(scene);
+    trace.follow(null);
+    energyPlot.clear();
+    speedPlot.clear();
+    readouts.reset(scene.n);
+    controls.setScene(scene);
+    messageBar.neutral(describeScene(scene));
+    messageBar.settle();
+    state.needsRedraw = true;
+    state.overlayDirty = true;
+    requestRender();
+  }
+
+  function applyStats(stats) {
+    state.stats = stats;
+    readouts.update(stats);
+    energyPlot.append(stats);
+    speedPlot.update(stats.histogram);
+  }
+
+  const handlers = {
+    hello: (message) => controls.setHello(message),
+    scene: applyScene,
+    status(message) {
+      state.status = message;
+      controls.setStatus(message);
+      messageBar.settle();
+    },
+    stats: applyStats,
+    traced(message) {
+      trace.follow(Number.isInteger(message.index) ? message.index : null);
+      state.overlayDirty = true;
+      requestRender();
+    },
+    export: (message) => saveTextFile(root, message.filename, message.toml ?? ""),
+    error(message) {
+      state.lastError = message;
+      report(message.field, message.reason ?? "error");
+    },
+  };
+
+  function receiveMessage(message) {
+    if (state.destroyed) return;
+    const handler = handlers[message.type];
+    if (!handler) return; // newer servers may send more; ignoring them keeps the page working
+    try {
+      handler(message);
+    } catch (error) {
+      console.error(`collidium: failed to handle a "${message.type}" message`, error);
+    }
+  }
+
+  // --- connection -----------------------------------------------------------------------------
+
+  transport.onOpen(() => {
+    if (state.destroyed) return;
+    state.connected = true;
+    messageBar.neutral("connected");
+    send({ type: "ready" });
+  });
+  transport.onMessage(receiveMessage);
+  transport.onFrame((buffer) => !state.destroyed && !state.stopped && receiveFrame(buffer));
+  transport.onClose(() => {
+    if (state.destroyed) return;
+    state.connected = false;
+    stopRendering();
+    messageBar.disconnected();
+    controls.setEnabled(false);
+  });
+
+  function stopRendering() {
+    state.stopped = true;
+    if (state.rafId) cancelAnimationFrame(state.rafId);
+    state.rafId = 0;
+  }
+
+  const resizeObserver = new ResizeObserver(resizeVessel);
+  resizeObserver.observe(layout.vessel);
+  window.addEventListener("resize", resizeVessel); // devicePixelRatio changes (zoom) land here
+  resizeVessel();
+
+  const hooks = {
+    send,
+    sendRaw: (text) => transport.sendRaw(text),
+    get framesDrawn() {
+      return state.framesDrawn;
+    },
+    get framesReceived() {
+      return state.framesReceived;
+    },
+    get lastError() {
+      return state.lastError;
+    },
+    get scene() {
+      return state.scene;
+    },
+    get stats() {
+      return state.stats;
+    },
+    get status() {
+      return state.status;
+    },
+    get energyPoints() {
+      return energyPlot.points;
+    },
+    get connected() {
+      return state.connected;
+    },
+  };
+
+  function destroy() {
+    if (state.destroyed) return;
+    state.destroyed = true;
+    state.connected = false;
+    stopRendering();
+    resizeObserver.disconnect();
+    window.removeEventListener("resize", resizeVessel);
+    detachPointer();
+    controls.destroy();
+    messageBar.destroy();
+    energyPlot.destroy();
+    speedPlot.destroy();
+    renderer.destroy();
+    transport.close();
+    root.replaceChildren();
+    root.classList.remove("collidium");
+  }
+
+  return { destroy, hooks };
+}

@@ -1,0 +1,363 @@
+"""`ViewerSession`: one simulation as the viewer shows and drives it, whatever the transport.
+
+The session owns the `Simulation` and what the controls change (playing, speed, heating,
+toggles, the traced particle). It answers with plain dicts (the JSON messages of
+`collidium.viewer.protocol`) and binary frames; `Connection` decides when to send them.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import time as clock
+from typing import Any
+
+import numpy as np
+
+from collidium import __version__
+from collidium.errors import InputError, SimulationError
+from collidium.observers.speeds import SpeedHistogram
+from collidium.observers.thermo import Thermo
+from collidium.presets import PRESETS, describe_presets, preset
+from collidium.scenario import Scenario
+from collidium.simulation import Simulation
+from collidium.state import FloatArray, uniform_or_each
+from collidium.viewer import protocol
+
+#: Bins of the live speed histogram.
+HISTOGRAM_BINS = 30
+#: Pressure and collision rate are averages over this many intervals between stats samples.
+WINDOW_SAMPLES = 5
+#: Longest wall-clock gap one `advance` makes up for, s (longer pauses are not caught up).
+MAX_CATCH_UP = 0.25
+#: Main parameters the page offers for a preset, when the preset takes them.
+MAIN_PARAMETERS = ("n", "dt", "k", "collisions")
+
+
+class ViewerSession:
+    """A simulation with the viewer's controls.
+
+    Parameters
+    ----------
+    scenario : Scenario, optional
+        What the session builds (and rebuilds on reset); its observers are not run.
+    simulation : Simulation, optional
+        A simulation to show as it is (give this or ``scenario``); reset returns to the state it
+        had when the session started.
+    preset : str, optional
+        The preset ``scenario`` came from, and ``overrides`` its parameters, shown on the page.
+    """
+
+    def __init__(
+        self,
+        scenario: Scenario | None = None,
+        simulation: Simulation | None = None,
+        preset: str | None = None,
+        overrides: dict[str, Any] | None = None,
+    ) -> None:
+        if (scenario is None) == (simulation is None):
+            raise InputError("session", "give a scenario or a simulation")
+        self.generation = 0
+        self.playing = True
+        self.speed = 1.0
+        self.momentum = False
+        #: Bumped whenever the state shown changes (a frame is due).
+        self.version = 0
+        if scenario is not None:
+            self._install(scenario, preset, overrides or {})
+        else:
+            assert simulation is not None
+            _check_size(simulation.particles.n, "particles")
+            self._start(simulation, None, None, {})
+
+    # -- set-up -----------------------------------------------------------------------------
+
+    def _install(self, scenario: Scenario, name: str | None, overrides: dict[str, Any]) -> None:
+        _check_size(scenario.particle_count, "n" if "n" in overrides else "particles")
+        sim = scenario.build()
+        sim.observers.clear()
+        self._start(sim, scenario, name, overrides)
+
+    def _start(
+        self,
+        sim: Simulation,
+        scenario: Scenario | None,
+        name: str | None,
+        overrides: dict[str, Any],
+    ) -> None:
+        self.sim = sim
+        self._scenario = scenario
+        self._preset = name
+        self._overrides = dict(overrides)
+        if scenario is None:  # keep the starting state for reset and export
+            self._initial = sim.particles.copy()
+        self._mode = sim.collisions if sim.collisions != "off" else "exact"
+        self._forces = sim.forces
+        self.collisions_enabled = sim.collisions != "off"
+        self.charges_enabled = bool(sim.forces)
+        self.traced: int | None = None
+        self.generation += 1
+        self._carry = 0.0
+        self._seconds_per_step = 1e-3
+        self._upper_speed = 0.0
+        self._changed()
+
+    def _changed(self) -> None:
+        """The state was changed from outside the dynamics: restart the drift and the windows."""
+        self._reference = self.sim.energy().total
+        self._thermo = Thermo()
+        self._pressure: float | None = None
+        self._rate: float | None = None
+        self._window: tuple[float, int] | None = None
+        self.version += 1
+
+    def _fresh(self) -> Simulation:
+        """A new simulation in the starting state."""
+        if self._scenario is not None:
+            sim = self._scenario.build()
+            sim.observers.clear()
+            return sim
+        old = self.sim
+        return Simulation(old.container, self._initial.copy(), forces=self._forces, dt=old.dt,
+                          collisions=self._mode, seed=old.seed, name=old.name)  # fmt: skip
+
+    # -- controls ---------------------------------------------------------------------------
+
+    def load(self, name: str, overrides: dict[str, Any]) -> None:
+        """Switch to a preset with parameter overrides (validated like the command line's)."""
+        if name not in PRESETS:
+            raise InputError("preset", f"unknown preset {name!r}; choose from {', '.join(PRESETS)}")
+        self._install(preset(name, **overrides), name, overrides)
+
+    def load_toml(self, text: str) -> None:
+        """Switch to a scenario given as TOML text (validated like a scenario file)."""
+        scenario = Scenario.from_toml_string(text, source="scenario")
+        if scenario.observers:
+            raise InputError(
+                "observers", "the viewer measures by itself; remove the [[observers]] tables"
+            )
+        self._install(scenario, None, {})
+
+    def reset(self) -> None:
+        """Back to the starting state (the toggles too)."""
+        self._start(self._fresh(), self._scenario, self._preset, self._overrides)
+
+    def step(self) -> None:
+        """One time step (pauses first)."""
+        self.playing = False
+        self._run(1)
+
+    def set_speed(self, value: float) -> None:
+        """Simulated seconds per wall-clock second."""
+        self.speed = float(value)
+        self._carry = 0.0
+
+    def heat(self, factor: float) -> None:
+        """Multiply the kinetic energy by ``factor`` (velocities by its square root)."""
+        self.sim.particles.velocity *= math.sqrt(factor)
+        self._changed()
+
+    def enable_collisions(self, enabled: bool) -> None:
+        """Collisions between disks on (the scenario's mode) or off (walls still reflect)."""
+        self.collisions_enabled = enabled
+        self.sim.collisions = self._mode if enabled else "off"
+        self._changed()
+
+    def enable_charges(self, enabled: bool) -> None:
+        """The scenario's forces on or off."""
+        if enabled and not self._forces:
+            raise InputError("charges", "this scenario has no forces to switch on")
+        self.charges_enabled = enabled
+        self.sim.forces = self._forces if enabled else ()
+        self._changed()
+
+    def trace(self, index: int | None) -> None:
+        """Follow particle ``index`` (None: none)."""
+        if index is not None:
+            self._check_index(index)
+        self.traced = index
+
+    def set_velocity(self, index: int, vx: float, vy: float) -> None:
+        """Give particle ``index`` the velocity (vx, vy) in m/s."""
+        self._check_index(index)
+        self.sim.particles.velocity[index] = (vx, vy)
+        self._changed()
+
+    def _check_index(self, index: int) -> None:
+        n = self.sim.particles.n
+        if index >= n:
+            raise InputError("index", f"no particle {index}; there are {n}")
+
+    # -- running ----------------------------------------------------------------------------
+
+    def advance(self, wall_seconds: float, budget: float) -> None:
+        """Run for ``wall_seconds`` times the speed of simulated time, in whole steps, spending
+        at most about ``budget`` s of computation (the simulation then runs slower than asked).
+
+        Raises
+        ------
+        SimulationError
+            If the run goes wrong; the session pauses.
+        """
+        if not self.playing:
+            return
+        dt = self.sim.dt
+        self._carry += min(wall_seconds, MAX_CATCH_UP) * self.speed
+        count = int(self._carry / dt + 1e-9)  # the slack keeps whole multiples whole
+        if count == 0:
+            return
+        affordable = max(1, int(budget / self._seconds_per_step))
+        if count > affordable:
+            count, self._carry = affordable, 0.0
+        else:
+            self._carry -= count * dt
+        start = clock.perf_counter()
+        self._run(count)
+        spent = (clock.perf_counter() - start) / count
+        self._seconds_per_step = 0.7 * self._seconds_per_step + 0.3 * spent
+
+    def _run(self, steps: int) -> None:
+        try:
+            self.sim.run(steps=steps)
+        except SimulationError:
+            self.playing = False
+            raise
+        finally:
+            self.version += 1
+
+    # -- what the front end is sent ---------------------------------------------------------
+
+    def hello(self) -> dict[str, Any]:
+        """The presets with their main parameters, and the limits."""
+        presets = [
+            {
+                "name": entry["name"],
+                "description": entry["description"],
+                "parameters": {
+                    key: value
+                    for key, value in entry["parameters"].items()
+                    if key in MAIN_PARAMETERS
+                },
+            }
+            for entry in describe_presets()
+        ]
+        limits = {
+            "max_particles": protocol.MAX_PARTICLES,
+            "speed": list(protocol.SPEED_RANGE),
+            "max_message_bytes": protocol.MAX_MESSAGE_BYTES,
+            "messages_per_second": protocol.MESSAGES_PER_SECOND,
+        }
+        return {"type": "hello", "version": __version__, "presets": presets, "limits": limits}
+
+    def scene(self) -> dict[str, Any]:
+        """The vessel and what each particle looks like."""
+        sim = self.sim
+        p = sim.particles
+        box = sim.container
+        return {
+            "type": "scene", "generation": self.generation, "name": sim.name,
+            "preset": self._preset, "overrides": self._overrides, "n": p.n,
+            "box": {"width": box.width, "height": box.height, "boundary": box.boundary},
+            "radius": _compact(p.radius), "charge": _compact(p.charge),
+            "mass": _compact(p.mass), "dt": sim.dt, "collisions": self._mode,
+            "has_charges": bool(self._forces) and bool(np.any(p.charge != 0)),
+        }  # fmt: skip
+
+    def status(self) -> dict[str, Any]:
+        """Playing, speed and the toggles."""
+        return {
+            "type": "status", "playing": self.playing, "speed": self.speed,
+            "collisions": self.collisions_enabled, "charges": self.charges_enabled,
+            "momentum": self.momentum,
+        }  # fmt: skip
+
+    def stats(self) -> dict[str, Any]:
+        """Readouts, energies and the speed histogram now (pressure and collision rate averaged
+        over the last window of `WINDOW_SAMPLES` calls)."""
+        sim = self.sim
+        self._sample_window()
+        energy = sim.energy()
+        drift = (energy.total - self._reference) / abs(self._reference) if self._reference else None
+        return {
+            "type": "stats", "time": sim.time, "steps": sim.steps, "n": sim.particles.n,
+            "temperature": _number(sim.temperature()), "pressure": self._pressure,
+            "pressure_kind": "virial" if sim.container.periodic else "wall",
+            "collision_rate": self._rate, "drift": _number(drift),
+            "energy": {"kinetic": energy.kinetic, "potential": energy.potential,
+                       "total": energy.total},
+            "total_speed": sim.total_speed(), "histogram": self._histogram(),
+        }  # fmt: skip
+
+    def _sample_window(self) -> None:
+        sim = self.sim
+        if self._window is None:
+            self._window = (sim.time, sim.counters.pair_collisions)
+            self._sampled_at = sim.time
+            self._thermo.compute(sim)
+            return
+        if sim.time == self._sampled_at:
+            return  # paused: nothing new to average
+        self._sampled_at = sim.time
+        self._thermo.compute(sim, reset=False)
+        if self._thermo.samples <= WINDOW_SAMPLES:  # samples bound WINDOW_SAMPLES intervals
+            return
+        start, pairs = self._window
+        if sim.container.periodic:
+            self._pressure = _number(self._thermo.virial_pressure())
+        else:
+            self._pressure = _number(self._thermo.wall_pressure()["total"])
+        self._rate = (sim.counters.pair_collisions - pairs) / (sim.time - start)
+        self._window = (sim.time, sim.counters.pair_collisions)
+        self._thermo.compute(sim)
+
+    def _histogram(self) -> dict[str, Any]:
+        sim = self.sim
+        kT = sim.temperature()
+        if not kT > 0:
+            return {"edges": [], "density": [], "maxwell_boltzmann": None}
+        scale = math.sqrt(kT / float(sim.particles.mass.min()))
+        if not scale * 4 <= self._upper_speed <= scale * 10:
+            self._upper_speed = _nice_ceiling(5 * scale)
+        histogram = SpeedHistogram(HISTOGRAM_BINS, (0.0, self._upper_speed)).compute(sim)
+        curve = histogram.maxwell_boltzmann().pdf(histogram.bin_centers)
+        return {
+            "edges": histogram.bin_edges.tolist(),
+            "density": histogram.density.tolist(),
+            "maxwell_boltzmann": curve.tolist(),
+        }
+
+    def frame(self, number: int) -> bytes:
+        """The binary frame of the current state (velocities included with momentum on)."""
+        p = self.sim.particles
+        return protocol.encode_frame(number, self.sim.time, self.generation, p.position,
+                                     p.velocity if self.momentum else None)  # fmt: skip
+
+    def export(self) -> dict[str, Any]:
+        """The scenario that reset returns to, as TOML, with a file name."""
+        scenario = self._scenario or Scenario.of_state(self._fresh())
+        filename = re.sub(r"[^A-Za-z0-9._-]+", "-", scenario.name).strip("-.") or "scenario"
+        return {"type": "export", "filename": f"{filename}.toml", "toml": scenario.to_toml()}
+
+
+def _check_size(n: int, field: str) -> None:
+    if n > protocol.MAX_PARTICLES:
+        raise InputError(field, f"{n} particles; the viewer takes at most {protocol.MAX_PARTICLES}")
+
+
+def _compact(values: FloatArray) -> float | list[float]:
+    """One number when all particles share it, else one per particle."""
+    shared = uniform_or_each(values)
+    return shared if isinstance(shared, float) else shared.tolist()
+
+
+def _number(value: float | None) -> float | None:
+    """``value``, or None if it is missing or not finite (JSON has no NaN)."""
+    return value if value is not None and math.isfinite(value) else None
+
+
+def _nice_ceiling(value: float) -> float:
+    """The smallest round number (1, 1.5, 2, 2.5, 3, 4, 5, 6 or 8 times a power of ten) at or
+    above ``value``."""
+    power = 10.0 ** math.floor(math.log10(value))
+    steps = (1, 1.5, 2, 2.5, 3, 4, 5, 6, 8, 10)
+    return next(m * power for m in steps if m * power >= value * (1 - 1e-12))

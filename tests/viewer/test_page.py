@@ -1,0 +1,133 @@
+"""The viewer's page in real chromium: disks drawn to scale and moving, plots updating, and the
+controls changing the simulation as they say."""
+
+from __future__ import annotations
+
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from collidium.presets import preset
+from collidium.scenario import Scenario
+
+GREY = np.array([0x7F, 0x7F, 0x7F])
+
+
+def readout(page, name: str) -> float:
+    value = page.get_attribute(f"#readout-{name}", "data-value")
+    assert value, f"readout {name} is empty"
+    return float(value)
+
+
+def pixels(page, selector: str) -> np.ndarray:
+    from PIL import Image
+
+    picture = Image.open(io.BytesIO(page.locator(selector).screenshot()))
+    return np.asarray(picture.convert("RGB")).astype(int)
+
+
+def grey_disk_pixels(image: np.ndarray) -> np.ndarray:
+    return (np.abs(image - GREY) <= 24).all(axis=2)
+
+
+def pause(page) -> None:
+    if page.evaluate("window.collidiumViewer.status.playing"):
+        page.click("#play")
+    page.wait_for_function("!window.collidiumViewer.status.playing")
+
+
+def test_disks_are_drawn_to_scale_and_move(page):
+    first = pixels(page, "#particles")
+    height, width = first.shape[:2]
+    metre = min(width, height) / 20.0  # the 20 m x 20 m vessel fills the shorter side
+    expected = 200 * math.pi * (0.25 * metre) ** 2  # the gas preset's 200 disks of r = 0.25 m
+    drawn = grey_disk_pixels(first).sum()
+    # The rim of each disk is drawn darker: allow for it (and for disks partly overlapping in
+    # the picture as they pass), but the area must be that of 200 disks of this size.
+    assert 0.6 * expected < drawn < 1.15 * expected
+    page.wait_for_timeout(500)
+    second = pixels(page, "#particles")
+    moved = (grey_disk_pixels(first) != grey_disk_pixels(second)).sum()
+    assert moved > 0.2 * drawn  # at ~10 m/s, most disks move by more than a radius in 0.5 s
+
+
+def test_plots_update(page):
+    points = page.evaluate("window.collidiumViewer.energyPoints")
+    before = pixels(page, "#energy-plot")
+    page.wait_for_function(f"window.collidiumViewer.energyPoints > {points + 3}")
+    page.wait_for_timeout(300)
+    assert (pixels(page, "#energy-plot") != before).any()
+    assert pixels(page, "#speed-plot").std() > 0
+
+
+def test_pause_stops_simulated_time_and_step_advances_it_by_dt(page):
+    pause(page)
+    page.wait_for_timeout(300)  # readouts already on their way arrive
+    stopped = readout(page, "time")
+    page.wait_for_timeout(1000)
+    assert readout(page, "time") == stopped
+    page.click("#step")
+    page.wait_for_function(
+        f"Number(document.querySelector('#readout-time').dataset.value) > {stopped}"
+    )
+    assert readout(page, "time") == pytest.approx(stopped + 0.01, abs=1e-9)
+
+
+def test_heat_raises_the_temperature_readout_by_its_factor(page):
+    pause(page)
+    page.wait_for_timeout(300)
+    before = readout(page, "temperature")
+    page.click("#heat")
+    page.wait_for_function(
+        f"Number(document.querySelector('#readout-temperature').dataset.value) > {before}"
+    )
+    assert readout(page, "temperature") == pytest.approx(1.25 * before, rel=1e-12)
+    page.click("#cool")
+    page.wait_for_function(
+        f"Number(document.querySelector('#readout-temperature').dataset.value) < {1.2 * before}"
+    )
+    assert readout(page, "temperature") == pytest.approx(before, rel=1e-12)
+
+
+def test_switching_preset_changes_n(page):
+    assert readout(page, "n") == 200
+    page.select_option("#preset", "pool-break")
+    page.wait_for_function("document.querySelector('#readout-n').dataset.value === '225'")
+    page.fill("#set-n", "150") if page.is_visible("#set-n") else None
+    page.select_option("#preset", "gas")
+    page.wait_for_function("document.querySelector('#readout-n').dataset.value === '200'")
+    page.fill("#set-n", "350")
+    page.click("#apply")
+    page.wait_for_function("document.querySelector('#readout-n').dataset.value === '350'")
+
+
+def test_a_malformed_message_gets_an_error_and_the_next_good_one_works(page):
+    page.evaluate("window.collidiumViewer.sendRaw('{not json')")
+    page.wait_for_function("window.collidiumViewer.lastError !== null")
+    error = page.evaluate("window.collidiumViewer.lastError")
+    assert error["field"] == "message" and "JSON" in error["reason"]
+    assert "message" in page.inner_text("#message")
+    pause(page)  # the next good message is obeyed
+    assert page.inner_text("#play").strip() == "Play"
+
+
+def test_collisions_toggle_and_download_give_what_they_say(page):
+    page.uncheck("#toggle-collisions")
+    page.wait_for_function("window.collidiumViewer.status.collisions === false")
+    with page.expect_download() as download:
+        page.click("#download")
+    saved = download.value
+    assert saved.suggested_filename == "gas.toml"
+    text = Path(saved.path()).read_text(encoding="utf-8")
+    assert Scenario.from_toml_string(text) == preset("gas")
+
+
+def test_the_page_is_saved_as_a_screenshot(page, artifacts):
+    page.check("#toggle-momentum")
+    page.wait_for_timeout(500)
+    target = artifacts / "viewer.png"
+    page.screenshot(path=str(target), full_page=True)
+    assert target.stat().st_size > 10_000

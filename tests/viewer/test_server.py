@@ -1,0 +1,105 @@
+"""The web server: the page, only the static folder, and websockets that survive bad input."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from starlette.testclient import TestClient
+from starlette.websockets import WebSocketDisconnect
+
+from collidium.presets import preset
+from collidium.viewer import protocol
+from collidium.viewer.server import MAX_CONNECTIONS, STATIC, create_app
+from collidium.viewer.session import ViewerSession
+
+
+@pytest.fixture
+def client() -> TestClient:
+    app = create_app(lambda: ViewerSession(preset("gas", n=20), preset="gas"))
+    return TestClient(app, base_url="http://127.0.0.1:8765")
+
+
+def test_the_page_and_its_bundle_are_served(client):
+    page = client.get("/")
+    assert page.status_code == 200 and 'src="static/app.js"' in page.text
+    for name in ("app.js", "app.css", "widget.js"):
+        response = client.get(f"/static/{name}")
+        assert response.status_code == 200
+        assert response.content == (STATIC / name).read_bytes()
+
+
+@pytest.mark.parametrize(
+    "path",
+    [
+        "/static/../server.py",
+        "/static/%2e%2e/server.py",
+        "/static/..%2fserver.py",
+        "/static/%2e%2e/%2e%2e/viewer/session.py",
+        "/etc/passwd",
+        "/server.py",
+    ],
+)
+def test_nothing_outside_the_static_folder_is_served(client, path):
+    response = client.get(path)
+    assert response.status_code == 404
+    assert b"ViewerSession" not in response.content and b"import" not in response.content
+
+
+def receive_json(ws) -> dict:
+    while True:
+        message = ws.receive()
+        if message.get("text") is not None:
+            return json.loads(message["text"])
+
+
+def test_a_websocket_gets_the_handshake_and_frames(client):
+    with client.websocket_connect("/ws") as ws:
+        ws.send_text(json.dumps({"type": "ready"}))
+        kinds = [receive_json(ws)["type"] for _ in range(4)]
+        assert kinds == ["hello", "scene", "status", "stats"]
+        frame = protocol.decode_frame(ws.receive_bytes())
+        assert frame["n"] == 20
+
+
+def test_a_malformed_message_gets_an_error_and_the_server_keeps_going(client):
+    with client.websocket_connect("/ws") as ws:
+        ws.send_text(json.dumps({"type": "ready"}))
+        ws.send_text("{this is not json")
+        ws.send_bytes(b"\xff\xfe")
+        errors = []
+        while len(errors) < 2:
+            reply = receive_json(ws)
+            if reply["type"] == "error":
+                errors.append(reply["field"])
+        assert errors == ["message", "message"]
+        ws.send_text(json.dumps({"type": "pause"}))
+        reply = receive_json(ws)
+        while reply["type"] != "status":
+            reply = receive_json(ws)
+        assert reply["playing"] is False
+
+
+def test_a_page_from_another_site_cannot_connect(client):
+    with (
+        pytest.raises(WebSocketDisconnect) as closed,
+        client.websocket_connect("/ws", headers={"origin": "http://evil.example"}) as ws,
+    ):
+        ws.receive_text()
+    assert closed.value.code == 1008
+
+
+def test_pages_beyond_the_limit_are_refused_with_a_reason(client):
+    import contextlib
+
+    with contextlib.ExitStack() as stack:
+        for _ in range(MAX_CONNECTIONS):
+            ws = stack.enter_context(client.websocket_connect("/ws"))
+            ws.send_text(json.dumps({"type": "ready"}))
+            receive_json(ws)
+        with client.websocket_connect("/ws") as extra:
+            reply = json.loads(extra.receive_text())
+            assert reply["field"] == "connection" and "close one" in reply["reason"]
+            with pytest.raises(WebSocketDisconnect) as closed:
+                extra.receive_text()
+            assert closed.value.code == 1013

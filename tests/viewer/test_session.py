@@ -1,0 +1,177 @@
+"""The viewer's session: controls change the simulation as they say, readouts measure it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from collidium.errors import InputError
+from collidium.observers.thermo import Thermo
+from collidium.presets import preset
+from collidium.scenario import Scenario
+from collidium.theory import MaxwellBoltzmann2D
+from collidium.viewer import protocol
+from collidium.viewer.session import WINDOW_SAMPLES, ViewerSession
+
+
+@pytest.fixture
+def gas() -> ViewerSession:
+    return ViewerSession(preset("gas", n=100), preset="gas", overrides={"n": 100})
+
+
+def test_advance_runs_speed_times_the_wall_time_in_whole_steps(gas):
+    gas.set_speed(2.0)
+    gas.advance(0.1, budget=10.0)
+    assert gas.sim.steps == 20
+    gas.advance(0.004, budget=10.0)  # 0.8 of a step is carried over...
+    assert gas.sim.steps == 20
+    gas.advance(0.001, budget=10.0)  # ...and taken once a whole step has accumulated
+    assert gas.sim.steps == 21
+
+
+def test_advance_gives_up_time_it_cannot_afford_and_never_runs_while_paused(gas):
+    gas._seconds_per_step = 1.0  # as if each step took a second
+    gas.advance(0.2, budget=0.01)
+    assert gas.sim.steps == 1  # one step, not the 20 asked for; the backlog is dropped
+    gas.playing = False
+    gas.advance(0.2, budget=10.0)
+    assert gas.sim.steps == 1
+
+
+def test_heat_multiplies_the_kinetic_energy_and_restarts_the_drift(gas):
+    before = gas.sim.energy().kinetic
+    gas.heat(1.25)
+    assert gas.sim.energy().kinetic == pytest.approx(1.25 * before, rel=1e-13)
+    assert gas.stats()["drift"] == 0.0
+    gas.heat(0.8)
+    assert gas.sim.energy().kinetic == pytest.approx(before, rel=1e-13)
+
+
+def test_collisions_switch_off_and_back_to_the_scenario_mode(gas):
+    gas.enable_collisions(False)
+    assert gas.sim.collisions == "off"
+    pairs = gas.sim.counters.pair_collisions
+    gas.sim.run(time=2.0)
+    assert gas.sim.counters.pair_collisions == pairs
+    gas.enable_collisions(True)
+    assert gas.sim.collisions == "exact"
+    gas.sim.run(time=2.0)
+    assert gas.sim.counters.pair_collisions > pairs
+    assert gas.sim.escaped() == 0
+
+
+def test_charges_switch_the_forces_off_and_on():
+    session = ViewerSession(preset("charged-gas", n=50))
+    assert session.scene()["has_charges"]
+    potential = session.sim.energy().potential
+    session.enable_charges(False)
+    assert session.sim.forces == () and session.sim.energy().potential == 0.0
+    session.enable_charges(True)
+    assert session.sim.energy().potential == potential
+
+
+def test_charges_cannot_be_switched_on_without_forces(gas):
+    assert not gas.scene()["has_charges"]
+    with pytest.raises(InputError, match="charges: this scenario has no forces"):
+        gas.enable_charges(True)
+
+
+def test_set_velocity_and_trace_check_the_index(gas):
+    gas.set_velocity(7, 3.0, -4.0)
+    np.testing.assert_array_equal(gas.sim.particles.velocity[7], [3.0, -4.0])
+    gas.sim.run(steps=1)  # the exact engine takes the edit
+    assert gas.sim.escaped() == 0
+    with pytest.raises(InputError, match="index: no particle 100; there are 100"):
+        gas.set_velocity(100, 0.0, 0.0)
+    gas.trace(99)
+    assert gas.traced == 99
+    with pytest.raises(InputError, match="index"):
+        gas.trace(100)
+
+
+def test_reset_returns_to_the_starting_state(gas):
+    start = gas.sim.particles.position.copy()
+    generation = gas.generation
+    gas.heat(2.0)
+    gas.enable_collisions(False)
+    gas.sim.run(time=1.0)
+    gas.reset()
+    np.testing.assert_array_equal(gas.sim.particles.position, start)
+    assert gas.sim.time == 0.0 and gas.sim.collisions == "exact"
+    assert gas.generation == generation + 1
+
+
+def test_a_simulation_given_directly_resets_to_its_state_when_shown():
+    sim = preset("gas", n=30).build()
+    sim.run(time=1.0)
+    start = sim.particles.position.copy()
+    session = ViewerSession(simulation=sim)
+    session.advance(0.5, budget=10.0)
+    session.reset()
+    np.testing.assert_array_equal(session.sim.particles.position, start)
+    exported = Scenario.from_toml_string(session.export()["toml"]).build()
+    np.testing.assert_array_equal(exported.particles.position, start)
+
+
+def test_load_switches_preset_and_refuses_what_the_files_refuse(gas):
+    gas.load("pool-break", {})
+    assert gas.sim.particles.n == 225 and gas.scene()["preset"] == "pool-break"
+    with pytest.raises(InputError, match="n: must be >= 0"):
+        gas.load("gas", {"n": -1})
+    with pytest.raises(InputError, match="preset: unknown preset 'nope'"):
+        gas.load("nope", {})
+    with pytest.raises(InputError, match=f"at most {protocol.MAX_PARTICLES}"):
+        gas.load("gas", {"n": protocol.MAX_PARTICLES + 1})  # refused before building
+    assert gas.sim.particles.n == 225  # nothing changed by the refusals
+
+
+def test_a_scenario_from_the_page_is_validated_like_a_file(gas):
+    text = preset("gas", n=40).to_toml()
+    gas.load_toml(text)
+    assert gas.sim.particles.n == 40 and gas.scene()["preset"] is None
+    with pytest.raises(InputError, match=r"run\.dt: must be > 0"):
+        gas.load_toml(text.replace("dt = 0.01", "dt = -1.0"))
+    with pytest.raises(InputError, match="observers: the viewer measures by itself"):
+        gas.load_toml(text + '\n[[observers]]\nkind = "trajectory"\npath = "x.gsd"\nevery = 1\n')
+
+
+def test_export_gives_the_scenario_reset_returns_to(gas):
+    exported = gas.export()
+    assert exported["filename"] == "gas.toml"
+    assert Scenario.from_toml_string(exported["toml"]) == preset("gas", n=100)
+
+
+def test_pressure_and_collision_rate_are_window_averages(gas):
+    thermo = Thermo().compute(gas.sim)
+    gas.stats()
+    pairs = gas.sim.counters.pair_collisions
+    for _ in range(WINDOW_SAMPLES):
+        gas.sim.run(steps=20)
+        thermo.compute(gas.sim, reset=False)
+        stats = gas.stats()
+    assert stats["pressure_kind"] == "wall"
+    assert stats["pressure"] == pytest.approx(thermo.wall_pressure()["total"], rel=1e-12)
+    expected = (gas.sim.counters.pair_collisions - pairs) / gas.sim.time
+    assert stats["collision_rate"] == pytest.approx(expected, rel=1e-12)
+
+
+def test_the_histogram_is_a_density_with_the_maxwell_boltzmann_curve(gas):
+    histogram = gas.stats()["histogram"]
+    edges = np.array(histogram["edges"])
+    density = np.array(histogram["density"])
+    speeds = np.hypot(*gas.sim.particles.velocity.T)
+    inside = np.mean(speeds < edges[-1])
+    assert np.sum(density * np.diff(edges)) == pytest.approx(inside, rel=1e-12)
+    assert edges[-1] > speeds.mean()
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    law = MaxwellBoltzmann2D(gas.sim.temperature(), gas.sim.particles.mass)
+    np.testing.assert_allclose(histogram["maxwell_boltzmann"], law.pdf(centres), rtol=1e-12)
+
+
+def test_frames_carry_positions_and_on_request_velocities(gas):
+    plain = protocol.decode_frame(gas.frame(4))
+    np.testing.assert_array_equal(plain["position"], gas.sim.particles.position.astype("f4"))
+    assert plain["velocity"] is None and plain["generation"] == gas.generation
+    gas.momentum = True
+    full = protocol.decode_frame(gas.frame(5))
+    np.testing.assert_array_equal(full["velocity"], gas.sim.particles.velocity.astype("f4"))

@@ -1,0 +1,79 @@
+"""The notebook widget: the anywidget's model messages carry the page's protocol."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from collidium.errors import InputError
+from collidium.presets import preset
+from collidium.viewer import Widget, protocol
+from collidium.viewer.server import STATIC
+
+
+@pytest.fixture
+def widget():
+    sim = preset("gas", n=40).build()
+    shown = Widget(sim)
+    shown.sent = []
+    shown.send = lambda content, buffers=None: shown.sent.append((content, buffers))
+    yield shown
+    shown.close()
+
+
+def message(widget, content):
+    """What the widget sends back for one message from its front end."""
+    widget.sent.clear()
+    widget._on_message(widget, content, [])
+    return list(widget.sent)
+
+
+def test_the_widget_carries_the_bundled_front_end(widget):
+    assert widget._esm == (STATIC / "widget.js").read_text(encoding="utf-8")
+    assert "render" in widget._esm and "export" in widget._esm
+
+
+def test_ready_gets_the_handshake_and_a_frame_as_a_buffer(widget):
+    sent = message(widget, {"type": "ready"})
+    kinds = [content["type"] for content, _ in sent]
+    assert kinds[:4] == ["hello", "scene", "status", "stats"] and "frame" in kinds
+    (buffers,) = [buffers for content, buffers in sent if content["type"] == "frame"]
+    frame = protocol.decode_frame(buffers[0])
+    np.testing.assert_array_equal(
+        frame["position"], widget.simulation.particles.position.astype("f4")
+    )
+
+
+def test_acks_release_frames_of_the_running_simulation(widget):
+    message(widget, {"type": "ready"})
+    times = []
+    for k in range(1, 6):
+        time.sleep(0.05)  # the simulation runs on wall-clock time
+        sent = message(widget, {"type": "ack", "frame": k})
+        times += [protocol.decode_frame(buffers[0])["time"] for _, buffers in sent if buffers]
+    assert len(times) == 5 and np.all(np.diff(times) > 0)
+    assert times[-1] == widget.simulation.time
+
+
+def test_controls_act_on_the_simulation_shown(widget):
+    message(widget, {"type": "ready"})
+    before = widget.simulation.energy().kinetic
+    sent = message(widget, {"type": "heat", "factor": 2.0})
+    assert widget.simulation.energy().kinetic == pytest.approx(2 * before, rel=1e-13)
+    stats = [content for content, _ in sent if content["type"] == "stats"]
+    assert stats[0]["temperature"] == pytest.approx(2 * before / 40, rel=1e-13)
+
+
+def test_a_malformed_raw_message_gets_an_error_and_the_next_good_one_works(widget):
+    message(widget, {"type": "ready"})
+    (error, _), *_ = message(widget, {"type": "raw", "text": "{oops"})
+    assert error["type"] == "error" and error["field"] == "message"
+    (status, _), *_ = message(widget, {"type": "pause"})
+    assert status == {**status, "type": "status", "playing": False}
+
+
+def test_a_widget_needs_something_to_show():
+    with pytest.raises(InputError, match="simulation: must be a Simulation"):
+        Widget(42)
