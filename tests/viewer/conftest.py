@@ -3,8 +3,6 @@ by Playwright (``.ci/run`` installs it; ``COLLIDIUM_CHROMIUM`` names another bin
 
 from __future__ import annotations
 
-import os
-import shutil
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -13,21 +11,7 @@ import pytest
 from collidium.presets import preset
 from collidium.viewer.server import create_app, running
 from collidium.viewer.session import ViewerSession
-
-#: Chromium's options for a headless run on a machine without a GPU or network.
-CHROMIUM_ARGS = [
-    "--headless=new", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader", "--disable-background-networking",
-    "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
-]  # fmt: skip
-
-
-def chromium_path() -> str:
-    """The chromium binary the tests drive; fails (never skips) when there is none."""
-    path = os.environ.get("COLLIDIUM_CHROMIUM") or shutil.which("chromium")
-    if not path:
-        pytest.fail("the viewer's browser tests need chromium: apt-get install chromium")
-    return path
+from collidium.viewer.testing import HEADLESS_CHROMIUM_ARGS, chromium_path
 
 
 @pytest.fixture(scope="session")
@@ -42,8 +26,13 @@ def artifacts() -> Path:
 def browser() -> Iterator[object]:
     from playwright.sync_api import sync_playwright
 
+    path = chromium_path()
+    if path is None:  # a failure, never a skip: CI installs it
+        pytest.fail("the viewer's browser tests need chromium: apt-get install chromium")
     with sync_playwright() as playwright:
-        launched = playwright.chromium.launch(executable_path=chromium_path(), args=CHROMIUM_ARGS)
+        launched = playwright.chromium.launch(
+            executable_path=path, args=list(HEADLESS_CHROMIUM_ARGS)
+        )
         yield launched
         launched.close()
 

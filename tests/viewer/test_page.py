@@ -131,3 +131,62 @@ def test_the_page_is_saved_as_a_screenshot(page, artifacts):
     target = artifacts / "viewer.png"
     page.screenshot(path=str(target), full_page=True)
     assert target.stat().st_size > 10_000
+
+
+TWO_DISKS = """
+name = "two"
+[box]
+width = 20.0
+height = 20.0
+[run]
+dt = 0.01
+[[particles]]
+kind = "explicit"
+position = [[-5.0, 0.0], [5.0, 0.0]]
+velocity = [[0.0, 0.0], [0.0, 0.0]]
+radius = 1.0
+"""
+
+
+def on_screen(page, x: float, y: float) -> tuple[float, float]:
+    """Page coordinates of the point (x, y) m of the 20 m x 20 m vessel: centred in the canvas,
+    y up, scaled to fill the shorter side less a 2 px margin."""
+    box = page.locator("#particles").bounding_box()
+    metre = (min(box["width"], box["height"]) - 4) / 20.0
+    return box["x"] + box["width"] / 2 + x * metre, box["y"] + box["height"] / 2 - y * metre
+
+
+def test_click_traces_a_disk_and_drag_gives_it_a_velocity(page):
+    page.set_input_files(
+        "#open-scenario",
+        files=[{"name": "two.toml", "mimeType": "text/plain", "buffer": TWO_DISKS.encode()}],
+    )
+    page.wait_for_function("document.querySelector('#readout-n').dataset.value === '2'")
+    pause(page)
+    assert readout(page, "temperature") == 0.0
+    page.mouse.click(*on_screen(page, 5.0, 0.0))  # a click on the right-hand disk traces it
+    start, end = on_screen(page, 5.0, 0.0), on_screen(page, 5.0, 3.0)
+    page.mouse.move(*start)
+    page.mouse.down()
+    page.mouse.move(*end, steps=8)
+    page.mouse.up()  # dragged 3 m up: velocity (0, 3) m/s
+    page.wait_for_function(
+        "Number(document.querySelector('#readout-temperature').dataset.value) > 0"
+    )
+    speed = math.sqrt(4 * readout(page, "temperature"))  # kT = KE / N = m v^2 / 4
+    box = page.locator("#particles").bounding_box()
+    pixel = 20.0 / (min(box["width"], box["height"]) - 4)  # a CSS pixel in m
+    assert speed == pytest.approx(3.0, abs=pixel)  # the pointer is only as exact as a pixel
+    before = pixels(page, "#overlay")
+    page.click("#play")
+    page.wait_for_function("Number(document.querySelector('#readout-time').dataset.value) > 1.5")
+    after = pixels(page, "#overlay")
+    orange = (np.abs(after - [0xFF, 0x7F, 0x0E]) <= 40).all(axis=2)
+    rows, columns = np.nonzero(orange & (after != before).any(axis=2))
+    x, y = on_screen(page, 5.0, 0.0)
+    offset = columns + box["x"] - x
+    # Everything drawn is the path straight up from (5, 0) m and the ring around the disk...
+    assert np.all(np.abs(offset) <= (1.0 + 0.2) / pixel)
+    # ...and the path is a vertical line from where the disk started to past 1.5 s x 3 m/s.
+    path = rows[np.abs(offset) <= 2] + box["y"]
+    assert path.max() >= y - 2 and path.min() <= y - 4.5 / pixel

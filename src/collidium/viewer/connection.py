@@ -22,8 +22,8 @@ Outgoing = dict[str, Any] | bytes
 MAX_CREDIT = 2
 #: Wall-clock seconds between readout updates while the state changes.
 STATS_PERIOD = 0.2
-#: Computation one tick may spend running the simulation, s.
-TICK_BUDGET = 0.03
+#: Computation one tick may spend running the simulation, s (leaves time for 30+ frames/s).
+TICK_BUDGET = 0.02
 
 
 class Connection:

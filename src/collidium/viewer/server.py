@@ -126,9 +126,11 @@ async def _converse(ws: WebSocket, connection: Connection) -> None:
                     await ws.send_text(json.dumps(item, allow_nan=False))
 
     async def pump() -> None:
+        loop = asyncio.get_running_loop()
         while True:
+            started = loop.time()
             await run(connection.tick)
-            await asyncio.sleep(TICK)
+            await asyncio.sleep(max(0.0, TICK - (loop.time() - started)))
 
     ticking = asyncio.create_task(pump())
     try:

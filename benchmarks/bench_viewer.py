@@ -1,0 +1,90 @@
+"""The live viewer end to end. Run: ``python benchmarks/bench_viewer.py [--quick]``.
+
+V1  frames per second drawn by the page in headless chromium (software WebGL through SwiftShader
+    here: a figure to report, not a gate; the target, 30 frames/s at N = 1e4, is for a machine
+    with a GPU), for the exact gas at packing 0.1 with N = 1e3, 1e4 and 1e5, and how fast the
+    simulation ran meanwhile (simulated seconds per wall second; 1 is what was asked for).
+V2  the server's share: milliseconds to encode one binary frame and bytes per frame.
+
+Prints a table and writes ``benchmarks/results/viewer.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from pathlib import Path
+
+from collidium.presets import preset
+from collidium.viewer.server import create_app, running
+from collidium.viewer.session import ViewerSession
+from collidium.viewer.testing import HEADLESS_CHROMIUM_ARGS, chromium_path
+
+RESULTS = Path(__file__).parent / "results"
+PACKING = 0.1
+
+
+def gas(n: int) -> ViewerSession:
+    """The gas preset with N disks of radius 0.25 m in a square box at packing 0.1."""
+    side = round(math.sqrt(n * math.pi * 0.25**2 / PACKING), 1)
+    return ViewerSession(preset("gas", n=n, width=side, height=side))
+
+
+def frames_per_second(browser: object, n: int, seconds: float) -> dict[str, float]:
+    """V1: frames drawn per wall second, and simulated per wall second, over ``seconds``."""
+    app = create_app(lambda: gas(n))
+    with running(app) as url:
+        page = browser.new_page(viewport={"width": 1280, "height": 800})  # type: ignore[attr-defined]
+        page.goto(url)
+        page.wait_for_function("window.collidiumViewer && window.collidiumViewer.framesDrawn > 5",
+                               timeout=120_000)  # fmt: skip
+        probe = "[window.collidiumViewer.framesDrawn, window.collidiumViewer.stats.time]"
+        frames0, time0 = page.evaluate(probe)
+        start = time.perf_counter()
+        page.wait_for_timeout(seconds * 1000)
+        frames1, time1 = page.evaluate(probe)
+        elapsed = time.perf_counter() - start
+        page.close()
+    return {"n": n, "fps": (frames1 - frames0) / elapsed, "speed": (time1 - time0) / elapsed}
+
+
+def encoding(n: int, repeats: int = 20) -> dict[str, float]:
+    """V2: encoding one frame (positions only) of N particles."""
+    session = gas(n)
+    start = time.perf_counter()
+    for k in range(repeats):
+        data = session.frame(k)
+    return {"n": n, "encode_ms": 1e3 * (time.perf_counter() - start) / repeats,
+            "bytes": len(data)}  # fmt: skip
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="shorter windows")
+    args = parser.parse_args()
+    seconds = 3.0 if args.quick else 8.0
+    path = chromium_path()
+    if path is None:
+        raise SystemExit("needs chromium: apt-get install chromium")
+    from playwright.sync_api import sync_playwright
+
+    sizes = (1_000, 10_000, 100_000)
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=path,
+                                             args=list(HEADLESS_CHROMIUM_ARGS))  # fmt: skip
+        drawn = [frames_per_second(browser, n, seconds) for n in sizes]
+        browser.close()
+    encoded = [encoding(n) for n in sizes]
+    print(f"{'N':>8} {'frames/s':>9} {'sim s / wall s':>15} {'encode ms':>10} {'bytes':>9}")
+    for d, e in zip(drawn, encoded, strict=True):
+        print(f"{d['n']:>8} {d['fps']:>9.1f} {d['speed']:>15.2f} {e['encode_ms']:>10.2f} "
+              f"{e['bytes']:>9}")  # fmt: skip
+    RESULTS.mkdir(exist_ok=True)
+    out = {"V1": drawn, "V2": encoded, "renderer": "chromium headless, SwiftShader (no GPU)"}
+    (RESULTS / "viewer.json").write_text(json.dumps(out, indent=2))
+
+
+if __name__ == "__main__":
+    main()
