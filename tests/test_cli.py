@@ -365,3 +365,55 @@ def test_movie_without_ffmpeg_falls_back_to_gif_with_a_one_line_warning(tmp_path
     assert captured.out.strip() == str(tmp_path / "m.gif")
     (line,) = captured.err.splitlines()
     assert line.startswith("warning: imageio-ffmpeg is not installed") and "[movie]" in line
+
+
+@pytest.mark.parametrize(
+    ("args", "line"),
+    [
+        (["nope"], "error: preset: unknown preset 'nope'"),
+        (["gas", "--set", "n=300000"], "error: n: 300000 particles; the viewer takes at most"),
+        (["gas", "--port", "70000"], "error: --port: must be in [0, 65535], got 70000"),
+        (["gas", "--host", "nosuchhost.invalid"], "error: --host: cannot resolve"),
+    ],
+)
+def test_view_refuses_bad_input_in_one_line(args, line):
+    result = collidium("view", *args, "--no-browser")
+    assert result.returncode == 2
+    assert result.stderr.startswith(line) and result.stderr.count("\n") == 1
+
+
+def test_view_serves_the_page_until_interrupted():
+    import urllib.request
+
+    process = subprocess.Popen(
+        [sys.executable, "-m", "collidium", "view", "gas", "--port", "0", "--no-browser"],
+        stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        line = process.stderr.readline()
+        assert line.startswith("collidium viewer at http://127.0.0.1:")
+        url = line.split()[3]
+        with urllib.request.urlopen(url, timeout=10) as page:
+            assert b"collidium viewer" in page.read()
+        taken = collidium("view", "--port", url.rsplit(":", 1)[1].strip("/"), "--no-browser")
+        assert taken.returncode == 2 and "error: --port: cannot listen" in taken.stderr
+    finally:
+        process.send_signal(signal.SIGINT)
+        _, rest = process.communicate(timeout=20)
+    assert process.returncode == 0
+    assert "Traceback" not in rest
+
+
+def test_view_warns_when_it_listens_beyond_this_machine():
+    process = subprocess.Popen(
+        [sys.executable, "-m", "collidium", "view", "--host", "0.0.0.0", "--port", "0",
+         "--no-browser"],
+        stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        warning = process.stderr.readline()
+        assert warning.startswith("warning: --host 0.0.0.0 lets every machine")
+        assert process.stderr.readline().startswith("collidium viewer at http://127.0.0.1:")
+    finally:
+        process.send_signal(signal.SIGINT)
+        process.communicate(timeout=20)

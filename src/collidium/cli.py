@@ -278,9 +278,9 @@ def view_command(
     name = scenario if scenario in PRESETS else None
     shown = {k: v for k, v in values.items() if "." not in k} if name else {}
     ViewerSession(spec, preset=name, overrides=shown)  # refuse a bad scenario before listening
+    sock = bind(host, port)
     if host not in LOOPBACK:
         _warn(f"--host {host} lets every machine that reaches this one run and steer simulations")
-    sock = bind(host, port)
     url = url_of(sock, host)
     sys.stderr.write(f"collidium viewer at {url} (Ctrl+C to stop)\n")
     if browser:

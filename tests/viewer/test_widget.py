@@ -33,6 +33,7 @@ def message(widget, content):
 def test_the_widget_carries_the_bundled_front_end(widget):
     assert widget._esm == (STATIC / "widget.js").read_text(encoding="utf-8")
     assert "render" in widget._esm and "export" in widget._esm
+    assert widget._css == (STATIC / "widget.css").read_text(encoding="utf-8")
 
 
 def test_ready_gets_the_handshake_and_a_frame_as_a_buffer(widget):
@@ -77,3 +78,55 @@ def test_a_malformed_raw_message_gets_an_error_and_the_next_good_one_works(widge
 def test_a_widget_needs_something_to_show():
     with pytest.raises(InputError, match="simulation: must be a Simulation"):
         Widget(42)
+
+
+def test_the_widget_front_end_runs_in_chromium_against_the_widget(browser, viewer_url):
+    """The bundled widget module, rendered as Jupyter would (``render({model, el})``), with a
+    model whose messages go to a real `Widget` and back."""
+    import base64
+
+    shown = Widget(preset("gas", n=60).build())
+    replies: list[tuple[dict, list[bytes] | None]] = []
+    shown.send = lambda content, buffers=None: replies.append((content, buffers))
+
+    def to_kernel(content: dict) -> list[list]:
+        replies.clear()
+        shown._on_message(shown, content, [])
+        return [[c, base64.b64encode(b[0]).decode() if b else None] for c, b in replies]
+
+    page = browser.new_page(viewport={"width": 1000, "height": 900})
+    page.goto(viewer_url + "static/widget.css")  # any page of the server: same origin
+    page.expose_function("toKernel", to_kernel)
+    # Jupyter puts the widget's CSS (its _css) in the page; the cell is about 900 px wide.
+    page.set_content(
+        "<link rel='stylesheet' href='/static/widget.css'><div id='cell' style='width: 900px'>"
+    )
+    page.evaluate(
+        """async () => {
+        const listeners = [];
+        const bytes = (text) => Uint8Array.from(atob(text), (c) => c.charCodeAt(0));
+        const model = {
+          on: (name, callback) => listeners.push(callback),
+          off: () => {},
+          send: async (content) => {
+            for (const [reply, buffer] of await window.toKernel(content)) {
+              const buffers = buffer === null ? [] : [new DataView(bytes(buffer).buffer)];
+              listeners.forEach((callback) => callback(reply, buffers));
+            }
+          },
+        };
+        const widget = (await import("/static/widget.js")).default;
+        widget.render({ model, el: document.getElementById("cell") });
+      }"""
+    )
+    hook = "document.getElementById('cell').collidiumViewer"
+    page.wait_for_function(f"{hook} && {hook}.framesDrawn > 10")
+    assert page.get_attribute("#cell #readout-n", "data-value") == "60"
+    assert shown.simulation.time > 0
+    page.click("#cell #play")
+    page.wait_for_function(f"{hook}.status.playing === false")
+    stopped = shown.simulation.time
+    page.wait_for_timeout(300)
+    assert shown.simulation.time == stopped
+    page.close()
+    shown.close()

@@ -174,9 +174,10 @@ def bind(host: str, port: int) -> socket.socket:
 
 
 def url_of(sock: socket.socket, host: str) -> str:
-    """The page's address for a bound socket."""
+    """The page's address for a bound socket (this machine's, when it listens on all)."""
     port = sock.getsockname()[1]
-    shown = f"[{host}]" if ":" in host else host
+    shown = {"0.0.0.0": "127.0.0.1", "::": "::1", "": "127.0.0.1"}.get(host, host)
+    shown = f"[{shown}]" if ":" in shown else shown
     return f"http://{shown}:{port}/"
 
 
@@ -191,8 +192,9 @@ def _server(app: Starlette) -> uvicorn.Server:
 
 
 def serve(app: Starlette, sock: socket.socket) -> None:
-    """Run the application on ``sock`` until interrupted."""
-    _server(app).run(sockets=[sock])
+    """Run the application on ``sock`` until Ctrl+C (a clean stop, exit status 0)."""
+    with contextlib.suppress(KeyboardInterrupt):  # uvicorn raises the signal again once stopped
+        _server(app).run(sockets=[sock])
 
 
 @contextlib.contextmanager
