@@ -220,3 +220,10 @@ def test_load_unknown_source():
         load("nothing")
     with pytest.raises(InputError, match="no such file"):
         load("nothing.toml")
+
+
+@pytest.mark.parametrize(("name", "key"), [("pool-break", "speed"), ("charged-gas", "charge")])
+@pytest.mark.parametrize("value", ["x", True, None, [1.0]])
+def test_a_number_parameter_refuses_other_values_in_one_line(name, key, value):
+    with pytest.raises(InputError, match=f"^{key}: must be a number, got "):
+        preset(name, **{key: value})

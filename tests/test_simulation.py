@@ -282,3 +282,21 @@ def test_points_wrap_through_a_periodic_box(mode):
     sim.run(time=10.0)
     np.testing.assert_allclose(sim.unwrapped_position(), start + 10.0 * velocity, atol=1e-12)
     assert sim.escaped() == 0
+
+
+def test_a_copy_continues_exactly_and_independently():
+    from collidium import load
+    from collidium.observers import EnergySeries
+
+    sim = load("gas", n=60)
+    sim.observers.append(EnergySeries())
+    sim.run(time=0.5)
+    twin = sim.copy()
+    assert twin.observers == [] and len(sim.observers) == 1
+    sim.run(time=1.0)
+    twin.run(time=1.0)
+    np.testing.assert_array_equal(twin.particles.position, sim.particles.position)
+    np.testing.assert_array_equal(twin.tally.counts, sim.tally.counts)
+    assert twin.time == sim.time
+    twin.particles.velocity *= 2
+    assert not np.array_equal(twin.particles.velocity, sim.particles.velocity)

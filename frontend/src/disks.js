@@ -1,6 +1,7 @@
-// WebGL (regl) drawing of the vessel: the box, every disk in one gl.POINTS call (round sprites
-// with a thin dark rim, sized from the radius) and, when the server sends velocities, one
-// gl.LINES call for the momentum vectors. Buffers are reused between frames.
+// WebGL (regl) drawing of the vessel: the box, every disk in one draw call (round gl.POINTS
+// sprites with a thin dark rim, sized from the radius; quads when a disk is larger than the GPU's
+// point size limit) and, when the server sends velocities, one gl.LINES call for the momentum
+// vectors. Buffers are reused between frames.
 import createREGL from "regl";
 
 const POSITIVE = [0xd6, 0x27, 0x28];
@@ -15,36 +16,83 @@ const RIM_CSS_PX = 1;
 const MOMENTUM_DIAMETERS = 2;
 const MOMENTUM_SAMPLE = 511;
 
-const DISK_VERT = `
+/** Quads and point sprites reach this many device pixels past the disk's edge, so the
+ * anti-aliased edge pixels are always covered and both drawing paths shade the same pixels. */
+const EDGE_PAD_PX = 1;
+
+// The size of a disk in device pixels, shared by both vertex shaders.
+const DISK_SIZE = `
+uniform float devicePixelsPerMetre, dotSize, minSize;
+float diskSize(vec4 style) {
+  return style.w > 0.0 ? max(2.0 * style.w * devicePixelsPerMetre, minSize) : dotSize;
+}`;
+
+// Fast path: one gl.POINTS sprite per disk (its size is capped by ALIASED_POINT_SIZE_RANGE).
+const POINT_VERT = `
 precision highp float;
 attribute vec2 position;
 attribute vec4 style; // rgb colour, radius in metres
 uniform vec2 scale;
-uniform float devicePixelsPerMetre, dotSize, minSize;
 varying vec3 vColor;
 varying float vSize;
+${DISK_SIZE}
 void main() {
-  float size = style.w > 0.0 ? max(2.0 * style.w * devicePixelsPerMetre, minSize) : dotSize;
+  float size = diskSize(style);
   vColor = style.rgb;
   vSize = size;
-  gl_PointSize = size;
+  gl_PointSize = size + ${(2 * EDGE_PAD_PX).toFixed(1)};
   gl_Position = vec4(position * scale, 0.0, 1.0);
 }`;
 
+// Large disks: a quad per disk (instanced, or two triangles); `corner` spans [-1, 1]².
+const QUAD_VERT = `
+precision highp float;
+attribute vec2 corner;
+attribute vec2 position;
+attribute vec4 style;
+uniform vec2 scale, clipPerPixel;
+varying vec3 vColor;
+varying float vSize;
+varying vec2 vOffset;
+${DISK_SIZE}
+void main() {
+  float size = diskSize(style);
+  vColor = style.rgb;
+  vSize = size;
+  vOffset = corner * (0.5 * size + ${EDGE_PAD_PX.toFixed(1)});
+  gl_Position = vec4(position * scale + vOffset * clipPerPixel, 0.0, 1.0);
+}`;
+
 // Distances are in device pixels so the rim and the anti-aliased edge stay ~1 px at any size.
-const DISK_FRAG = `
+// highp where available: mediump (fp16 on some GPUs) is too coarse across a 500 px disk.
+const DISK_SHADE = `
+#ifdef GL_FRAGMENT_PRECISION_HIGH
+precision highp float;
+#else
 precision mediump float;
+#endif
 uniform float rimWidth;
 varying vec3 vColor;
 varying float vSize;
-void main() {
+// The disk's colour (premultiplied) r device pixels from its centre.
+vec4 shade(float r) {
   float edge = 0.5 * vSize;
-  float r = length(2.0 * gl_PointCoord - 1.0) * edge;
-  if (r > edge) discard;
-  float alpha = clamp(edge - r + 0.5, 0.0, 1.0);
+  float alpha = clamp(edge - r + 0.5, 0.0, 1.0); // anti-aliased across the last pixel
+  if (alpha <= 0.0) discard; // not at r > edge: a jump there makes rounding show as speckles
   float rim = smoothstep(edge - rimWidth - 0.5, edge - rimWidth + 0.5, r);
   vec3 colour = mix(vColor, vColor * 0.4, rim);
-  gl_FragColor = vec4(colour * alpha, alpha);
+  return vec4(colour * alpha, alpha);
+}`;
+
+const POINT_FRAG = `${DISK_SHADE}
+void main() {
+  gl_FragColor = shade(length(2.0 * gl_PointCoord - 1.0) * (0.5 * vSize + ${EDGE_PAD_PX.toFixed(1)}));
+}`;
+
+const QUAD_FRAG = `${DISK_SHADE}
+varying vec2 vOffset;
+void main() {
+  gl_FragColor = shade(length(vOffset));
 }`;
 
 const FLAT_VERT = `
@@ -100,21 +148,109 @@ function sampledMedian(values, scratch) {
   return sample[count >> 1];
 }
 
-/** The renderer for `canvas`, mapping metres to pixels with `viewport`. */
+/** A regl instance on `canvas`, or null where WebGL cannot be created (never throws). */
+function createContext(canvas) {
+  const warn = (error) => console.warn("collidium: WebGL is not available", error);
+  try {
+    return createREGL({
+      canvas,
+      attributes: { antialias: true, premultipliedAlpha: true },
+      optionalExtensions: ["ANGLE_instanced_arrays"],
+      onDone: (error) => error && warn(error), // regl's default onDone throws
+    });
+  } catch (error) {
+    warn(error);
+    return null;
+  }
+}
+
+/** Frees `regl`'s resources and its WebGL context at once, rather than when it is collected. */
+function destroyContext(regl) {
+  const gl = regl._gl;
+  regl.destroy();
+  // Browsers keep only ~16 live contexts; re-rendered notebook widgets would use them all up.
+  gl.getExtension("WEBGL_lose_context")?.loseContext();
+}
+
+const STRIP_CORNERS = [[-1, -1], [1, -1], [-1, 1], [1, 1]];
+const TRIANGLE_CORNERS = [-1, -1, 1, -1, -1, 1, -1, 1, 1, -1, 1, 1];
+const TRIANGLE_VERTICES = TRIANGLE_CORNERS.length / 2;
+
+/** Copies `width` floats per item of `source` into `target`, each repeated `times` times. */
+function repeatEach(source, width, n, times, target) {
+  for (let i = 0; i < n; i += 1) {
+    for (let v = 0; v < times; v += 1) {
+      for (let c = 0; c < width; c += 1) target[(times * i + v) * width + c] = source[width * i + c];
+    }
+  }
+}
+
+/**
+ * Quads without instancing (ANGLE_instanced_arrays missing): two triangles per disk, its
+ * attributes repeated per vertex into reused arrays. Only re-expands what changed.
+ */
+function createTriangleQuads(regl) {
+  const empty = () => regl.buffer({ usage: "dynamic", type: "float", length: 16 });
+  const attributes = { corner: empty(), position: empty(), style: empty() };
+  let capacity = 0;
+  let positionData = new Float32Array(0);
+  let styleData = new Float32Array(0);
+  let uploaded = { positions: null, styles: null };
+
+  function reserve(n) {
+    if (n <= capacity) return;
+    capacity = n;
+    positionData = new Float32Array(2 * TRIANGLE_VERTICES * n);
+    styleData = new Float32Array(4 * TRIANGLE_VERTICES * n);
+    const corners = new Float32Array(TRIANGLE_CORNERS.length * n);
+    for (let i = 0; i < n; i += 1) corners.set(TRIANGLE_CORNERS, TRIANGLE_CORNERS.length * i);
+    attributes.corner({ usage: "static", type: "float", data: corners });
+    uploaded = { positions: null, styles: null };
+  }
+
+  /** Makes the buffers hold `n` disks of `positions` and `styles` (arrays compared by identity). */
+  function update(positions, styles, n) {
+    reserve(n);
+    if (styles !== uploaded.styles) {
+      repeatEach(styles, 4, n, TRIANGLE_VERTICES, styleData);
+      attributes.style({ usage: "static", type: "float", data: styleData.subarray(0, 4 * TRIANGLE_VERTICES * n) });
+    }
+    if (positions !== uploaded.positions) {
+      repeatEach(positions, 2, n, TRIANGLE_VERTICES, positionData);
+      attributes.position({ usage: "dynamic", type: "float", data: positionData.subarray(0, 2 * TRIANGLE_VERTICES * n) });
+    }
+    uploaded = { positions, styles };
+  }
+
+  return { attributes, update };
+}
+
+/**
+ * The renderer for `canvas`, mapping metres to pixels with `viewport`, or null where WebGL is not
+ * available.
+ */
 export function createDiskRenderer(canvas, viewport) {
-  const regl = createREGL({ canvas, attributes: { antialias: true, premultipliedAlpha: true } });
+  const regl = createContext(canvas);
+  if (!regl) return null;
   const blend = {
     enable: true,
     func: { srcRGB: 1, srcAlpha: 1, dstRGB: "one minus src alpha", dstAlpha: "one minus src alpha" },
   };
+  // gl.POINTS sprites are clamped to this size (often 255-511 px on real GPUs); queried once.
+  const maxPointSize = regl.limits.pointSizeDims[1];
+  const instanced = regl.hasExtension("ANGLE_instanced_arrays");
 
   let capacity = 0;
   let count = 0;
   let lineVertices = 0;
   let masses = new Float32Array(0);
+  let styles = new Float32Array(0);
+  let shownPositions = new Float32Array(0); // the last frame's, for the triangle quads
   let typicalRadius = 0;
+  let largestRadius = 0;
   let lineData = new Float32Array(0);
   let momenta = new Float32Array(0);
+  let diskPath = "points";
   const medianScratch = new Float32Array(MOMENTUM_SAMPLE);
   const positionBuffer = regl.buffer({ usage: "dynamic", type: "float", length: 8 });
   const styleBuffer = regl.buffer({ usage: "static", type: "float", length: 16 });
@@ -123,22 +259,59 @@ export function createDiskRenderer(canvas, viewport) {
   const boxFill = regl.buffer([[-0.5, -0.5], [0.5, -0.5], [-0.5, 0.5], [0.5, 0.5]]);
   const boxOutline = regl.buffer([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]]);
 
-  const drawDisks = regl({
-    vert: DISK_VERT,
-    frag: DISK_FRAG,
+  const diskUniforms = {
+    scale: regl.prop("scale"),
+    devicePixelsPerMetre: regl.prop("devicePixelsPerMetre"),
+    dotSize: regl.prop("dotSize"),
+    minSize: regl.prop("minSize"),
+    rimWidth: regl.prop("rimWidth"),
+  };
+  const quadUniforms = {
+    ...diskUniforms,
+    clipPerPixel: ({ viewportWidth, viewportHeight }) => [2 / viewportWidth, 2 / viewportHeight],
+  };
+  const diskState = { blend, depth: { enable: false } };
+
+  const drawPoints = regl({
+    ...diskState,
+    vert: POINT_VERT,
+    frag: POINT_FRAG,
     primitive: "points",
     attributes: { position: positionBuffer, style: styleBuffer },
-    uniforms: {
-      scale: regl.prop("scale"),
-      devicePixelsPerMetre: regl.prop("devicePixelsPerMetre"),
-      dotSize: regl.prop("dotSize"),
-      minSize: regl.prop("minSize"),
-      rimWidth: regl.prop("rimWidth"),
-    },
+    uniforms: diskUniforms,
     count: regl.prop("count"),
-    blend,
-    depth: { enable: false },
   });
+
+  // A unit quad per disk, the disk's attributes advancing once per instance (divisor 1).
+  const drawInstancedQuads =
+    instanced &&
+    regl({
+      ...diskState,
+      vert: QUAD_VERT,
+      frag: QUAD_FRAG,
+      primitive: "triangle strip",
+      attributes: {
+        corner: regl.buffer(STRIP_CORNERS),
+        position: { buffer: positionBuffer, divisor: 1 },
+        style: { buffer: styleBuffer, divisor: 1 },
+      },
+      uniforms: quadUniforms,
+      count: STRIP_CORNERS.length,
+      instances: regl.prop("count"),
+    });
+
+  const triangles = instanced ? null : createTriangleQuads(regl);
+  const drawTriangleQuads =
+    triangles &&
+    regl({
+      ...diskState,
+      vert: QUAD_VERT,
+      frag: QUAD_FRAG,
+      primitive: "triangles",
+      attributes: triangles.attributes,
+      uniforms: quadUniforms,
+      count: (context, props) => TRIANGLE_VERTICES * props.count,
+    });
 
   const drawFlat = regl({
     vert: FLAT_VERT,
@@ -163,8 +336,10 @@ export function createDiskRenderer(canvas, viewport) {
     const radii = perParticle(scene.radius, n, 0);
     masses = perParticle(scene.mass, n, 1);
     typicalRadius = sampledMedian(radii, medianScratch);
+    largestRadius = radii.reduce((most, radius) => Math.max(most, radius), 0);
     boundary = scene.box?.boundary ?? "reflecting";
-    styleBuffer({ usage: "static", type: "float", data: buildStyles(radii, perParticle(scene.charge, n, 0)) });
+    styles = buildStyles(radii, perParticle(scene.charge, n, 0));
+    styleBuffer({ usage: "static", type: "float", data: styles });
     if (n !== capacity) reallocate(n);
     count = 0;
     lineVertices = 0;
@@ -183,6 +358,7 @@ export function createDiskRenderer(canvas, viewport) {
   function setFrame(frame) {
     if (frame.n !== capacity) return;
     positionBuffer.subdata(frame.positions);
+    shownPositions = frame.positions;
     count = frame.n;
     lineVertices = frame.velocities ? buildMomentumLines(frame.positions, frame.velocities, frame.n) : 0;
   }
@@ -233,5 +409,30 @@ export function createDiskRenderer(canvas, viewport) {
     }
   }
 
-  return { setScene, setFrame, draw, destroy: () => regl.destroy() };
+  /** Points while the largest disk fits the point size limit (most scenes), else quads. */
+  function drawDisks(props) {
+    const largest = Math.max(2 * largestRadius * props.devicePixelsPerMetre, props.minSize, props.dotSize);
+    if (largest + 2 * EDGE_PAD_PX <= maxPointSize) {
+      diskPath = "points";
+      drawPoints(props);
+    } else if (drawInstancedQuads) {
+      diskPath = "instanced quads";
+      drawInstancedQuads(props);
+    } else {
+      diskPath = "triangles";
+      triangles.update(shownPositions, styles, count);
+      drawTriangleQuads(props);
+    }
+  }
+
+  return {
+    setScene,
+    setFrame,
+    draw,
+    destroy: () => destroyContext(regl),
+    /** How the disks were last drawn: "points", "instanced quads" or "triangles". */
+    get diskPath() {
+      return diskPath;
+    },
+  };
 }

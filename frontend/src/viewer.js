@@ -15,6 +15,10 @@ import { createTracePath } from "./trace.js";
 
 /** Extra reach, in CSS pixels, around a disk when clicking on it. */
 const PICK_SLACK_PX = 3;
+const NO_WEBGL = "WebGL is not available in this browser: the disks cannot be drawn";
+
+/** Stands in for the disk renderer without WebGL, so plots, readouts, controls and acks go on. */
+const NO_RENDERER = { setScene() {}, setFrame() {}, draw() {}, destroy() {}, diskPath: null };
 
 /** The static DOM: vessel (WebGL canvas + overlay), plots, readouts, controls, message bar. */
 function buildLayout(root) {
@@ -46,11 +50,12 @@ function describeScene(scene) {
 export function mountViewer(root, transport) {
   const layout = buildLayout(root);
   const viewport = createViewport();
-  const renderer = createDiskRenderer(layout.particles, viewport);
+  const messageBar = createMessageBar(layout.message);
+  const renderer = createDiskRenderer(layout.particles, viewport) ?? NO_RENDERER;
+  if (renderer === NO_RENDERER) messageBar.lasting(NO_WEBGL);
   const overlay = createOverlay(layout.overlay, viewport);
   const energyPlot = createEnergyPlot(layout.energy);
   const speedPlot = createSpeedPlot(layout.speed);
-  const messageBar = createMessageBar(layout.message);
   const readouts = createReadouts(layout.readouts);
   const trace = createTracePath();
   const send = (message) => transport.send(message);
@@ -299,6 +304,20 @@ export function mountViewer(root, transport) {
     state.rafId = 0;
   }
 
+  // A hidden page gets no animation frames, so drawing and acks pause and the server stops
+  // advancing: intended. On return, restart the loop: every frame received meanwhile is acked
+  // and the newest drawn (a fresh request, should a browser drop one made while hidden).
+  const page = root.ownerDocument;
+  function resumeWhenVisible() {
+    if (page.visibilityState === "hidden" || state.stopped) return;
+    if (state.rafId) cancelAnimationFrame(state.rafId);
+    state.rafId = 0;
+    state.needsRedraw = true;
+    state.overlayDirty = true;
+    requestRender();
+  }
+  page.addEventListener("visibilitychange", resumeWhenVisible);
+
   const resizeObserver = new ResizeObserver(resizeVessel);
   resizeObserver.observe(layout.vessel);
   window.addEventListener("resize", resizeVessel); // devicePixelRatio changes (zoom) land here
@@ -331,6 +350,10 @@ export function mountViewer(root, transport) {
     get connected() {
       return state.connected;
     },
+    /** How the disks are drawn: "points", "instanced quads", "triangles"; null without WebGL. */
+    get diskPath() {
+      return renderer.diskPath;
+    },
   };
 
   function destroy() {
@@ -340,6 +363,7 @@ export function mountViewer(root, transport) {
     stopRendering();
     resizeObserver.disconnect();
     window.removeEventListener("resize", resizeVessel);
+    page.removeEventListener("visibilitychange", resumeWhenVisible);
     detachPointer();
     controls.destroy();
     messageBar.destroy();

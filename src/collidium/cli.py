@@ -264,7 +264,15 @@ def view_command(
     """Watch and steer a simulation live in the browser (until Ctrl+C)."""
     from collidium.loading import load_scenario
     from collidium.presets import PRESETS
-    from collidium.viewer.server import LOOPBACK, bind, check_built, create_app, serve, url_of
+    from collidium.viewer.server import (
+        LOOPBACK,
+        LOOPBACK_HOSTS,
+        bind,
+        check_built,
+        create_app,
+        serve,
+        url_of,
+    )  # fmt: skip
     from collidium.viewer.session import ViewerSession
 
     check_built()
@@ -287,7 +295,8 @@ def view_command(
         import webbrowser
 
         webbrowser.open(url)
-    serve(create_app(lambda: ViewerSession(spec, preset=name, overrides=shown)), sock)
+    hosts = LOOPBACK_HOSTS if host in LOOPBACK else ("*",)
+    serve(create_app(lambda: ViewerSession(spec, preset=name, overrides=shown), hosts=hosts), sock)
 
 
 def _warn(line: str) -> None:

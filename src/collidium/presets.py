@@ -281,11 +281,15 @@ def preset(name: str, **overrides: Any) -> Scenario:
         scenario field for a bad value.
     """
     allowed = _entry(name).parameters
-    for key in overrides:
+    for key, value in overrides.items():
         if key not in allowed:
             raise InputError(
                 key, f"not a parameter of preset {name!r}; it takes: {', '.join(allowed)}"
             )
+        if isinstance(allowed[key], float) and (
+            isinstance(value, bool) or not isinstance(value, int | float)
+        ):  # the scenario checks values, but a preset's title formats them first
+            raise InputError(key, f"must be a number, got {value!r}")
     try:
         return _scenario(name, _COMMON | allowed | overrides)
     except InputError as exc:

@@ -506,11 +506,7 @@ class Scenario(_Model):
     @classmethod
     def from_toml_string(cls, text: str, source: str = "<string>") -> Scenario:
         """Parse and validate scenario TOML text (``source`` names it in errors)."""
-        try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise InputError(source, f"invalid TOML: {exc}") from None
-        return cls.from_dict(data)
+        return cls.from_dict(parse_toml(text, source))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data (Python floats, ints, str, lists, dicts); unset optional values and an empty
@@ -714,10 +710,17 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         raise InputError(name, f"not UTF-8 text ({exc.reason} at byte {exc.start})") from None
     except OSError as exc:
         raise InputError(name, f"cannot read: {exc.strerror or exc}") from None
+    return parse_toml(text, name)
+
+
+def parse_toml(text: str, source: str) -> dict[str, Any]:
+    """Parse TOML text; ``source`` names it in the `InputError` for bad syntax."""
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise InputError(name, f"invalid TOML: {exc}") from None
+        raise InputError(source, f"invalid TOML: {exc}") from None
+    except RecursionError:
+        raise InputError(source, "invalid TOML: arrays or tables nested too deeply") from None
 
 
 def _toml_scalar(value: Any) -> str:

@@ -13,6 +13,7 @@ Run loop, one step of length dt:
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -259,9 +260,11 @@ class Simulation:
 
     def energy(self) -> Energy:
         """Kinetic (``sum m v^2 / 2``) and potential (pair sum, seed eq. 10) energy in J."""
+        return Energy(self._kinetic(), self._field.potential(self.particles, self.container))
+
+    def _kinetic(self) -> float:
         p = self.particles
-        kinetic = 0.5 * float(np.sum(p.mass * np.einsum("ij,ij->i", p.velocity, p.velocity)))
-        return Energy(kinetic, self._field.potential(p, self.container))
+        return 0.5 * float(np.sum(p.mass * np.einsum("ij,ij->i", p.velocity, p.velocity)))
 
     def temperature(self) -> float:
         """kT = KE / N in J (2 degrees of freedom per particle, Boltzmann's constant 1); NaN
@@ -272,7 +275,7 @@ class Simulation:
         equipartition value ``(KE - P^2 / 2M) / (N - 1)`` differs from it by order 1/N.
         """
         n = self.particles.n
-        return self.energy().kinetic / n if n else float("nan")
+        return self._kinetic() / n if n else float("nan")  # no pair sum: it is O(N^2)
 
     def virial(self) -> float:
         """Pair virial of the forces, ``sum_{i<j} r_ij . F_ij``, in J at the current positions
@@ -343,6 +346,16 @@ class Simulation:
             "rng": self.rng.bit_generator.state,
         }
         write_checkpoint(path, arrays, {"simulation": state, "extra": meta})
+
+    def copy(self) -> Simulation:
+        """An independent copy (state, counters, engine queue, random generator), without the
+        observers; it continues exactly as this simulation would."""
+        observers, attached = self.observers, self._attached
+        self.observers, self._attached = [], []
+        try:
+            return copy.deepcopy(self)
+        finally:
+            self.observers, self._attached = observers, attached
 
     def __repr__(self) -> str:
         return (

@@ -50,6 +50,10 @@ def page(browser, viewer_url) -> Iterator[object]:
     opened = context.new_page()
     problems: list[str] = []
     opened.on("pageerror", lambda error: problems.append(str(error)))
+    opened.on(
+        "console",
+        lambda message: problems.append(message.text) if message.type == "error" else None,
+    )
     opened.goto(viewer_url)
     opened.wait_for_function("window.collidiumViewer && window.collidiumViewer.framesDrawn > 2")
     yield opened

@@ -7,7 +7,7 @@ import pytest
 from collidium.errors import SimulationError
 from collidium.presets import preset
 from collidium.viewer import protocol
-from collidium.viewer.connection import MAX_CREDIT, STATS_PERIOD, Connection
+from collidium.viewer.connection import MAX_CREDIT, STALL_SECONDS, STATS_PERIOD, Connection
 from collidium.viewer.session import ViewerSession
 
 
@@ -28,7 +28,9 @@ def clock() -> Clock:
 
 @pytest.fixture
 def connection(clock) -> Connection:
-    return Connection(ViewerSession(preset("gas", n=50), preset="gas"), clock=clock)
+    made = Connection(ViewerSession(preset("gas", n=50), preset="gas"), clock=clock)
+    made.budget = 1e9  # the test's clock decides how far it runs, not the machine's speed
+    return made
 
 
 def kinds(items):
@@ -115,9 +117,73 @@ def test_control_messages_are_rate_limited_but_acks_are_not(connection):
     replies = [connection.receive({"type": "play"})[0] for _ in range(protocol.MESSAGE_BURST)]
     assert sum(reply["type"] == "error" for reply in replies) == 1  # ready took one token
     assert replies[-1]["reason"].startswith("too many messages")
+    assert connection.receive("{malformed")[0]["reason"].startswith("too many messages")
     assert connection.receive({"type": "ack", "frame": 1}) == []
     connection._clock.now += 1.0  # a second later the bucket has refilled
     assert kinds(connection.receive({"type": "pause"})) == ["status"]
+
+
+def test_rebuilding_costs_more_of_the_rate_than_a_control(connection):
+    connection.receive({"type": "ready"})
+    answers = [connection.receive({"type": "reset"})[0]["type"] for _ in range(11)]
+    assert answers.count("scene") == protocol.MESSAGE_BURST // 10 - 1  # ready took a token
+    assert answers[-1] == "error"
+
+
+@pytest.mark.parametrize(
+    "data",
+    [
+        "[" * 100_000,
+        '{"type": "trace", "index": ' + "9" * 5000 + "}",
+        {"type": "load", "preset": "pool-break", "overrides": {"speed": "fast"}},
+        {"type": "scenario", "toml": "a = " + "[" * 5000},
+        {
+            "type": "scenario",
+            "toml": "[[particles]]\nkind = 'random'\nn = 10\n[run]\ndt = 5e-324\n",
+        },
+    ],
+    ids=["deep-json", "huge-int", "preset-type", "deep-toml", "tiny-dt"],
+)
+def test_hostile_messages_get_an_error_or_run_safely_and_the_session_goes_on(
+    connection, clock, data
+):
+    connection.receive({"type": "ready"})
+    replies = connection.receive(data)
+    clock.now += 0.25
+    replies += connection.tick()
+    assert all(isinstance(reply, bytes) or reply["type"] != "error"
+               or reply["field"] != "server" for reply in replies)  # fmt: skip
+    assert connection.receive({"type": "pause"}) == [connection.session.status()]
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered")
+def test_heating_without_bound_ends_in_an_error_not_in_a_dead_connection(connection, clock):
+    connection.receive({"type": "ready"})
+    for _ in range(400):  # the kinetic energy overflows to infinity
+        connection.session.heat(10.0)
+    clock.now += 0.25
+    replies = connection.tick()
+    errors = [r for r in replies if not isinstance(r, bytes) and r["type"] == "error"]
+    assert errors and errors[0]["field"] == "run" and "run away" in errors[0]["reason"]
+    assert connection.receive({"type": "reset"})[0]["type"] == "scene"
+
+
+def test_a_front_end_that_stops_acknowledging_stops_the_simulation(connection, clock):
+    connection.receive({"type": "ready"})
+    for _ in range(3):
+        clock.now += 0.1
+        connection.tick()  # two frames are sent, then credit runs out
+    clock.now += STALL_SECONDS + 0.1
+    connection.tick()
+    stopped = connection.session.sim.time
+    for _ in range(5):
+        clock.now += 0.5
+        assert connection.tick() == []
+    assert connection.session.sim.time == stopped
+    connection.receive({"type": "ack", "frame": 1})
+    clock.now += 0.1
+    assert "frame" in kinds(connection.tick())
+    assert connection.session.sim.time > stopped
 
 
 def test_a_failing_run_pauses_and_reports_one_line(connection, clock, monkeypatch):

@@ -96,7 +96,7 @@ def test_switching_preset_changes_n(page):
     assert readout(page, "n") == 200
     page.select_option("#preset", "pool-break")
     page.wait_for_function("document.querySelector('#readout-n').dataset.value === '225'")
-    page.fill("#set-n", "150") if page.is_visible("#set-n") else None
+    assert not page.is_visible("#set-n")  # pool-break takes no N
     page.select_option("#preset", "gas")
     page.wait_for_function("document.querySelector('#readout-n').dataset.value === '200'")
     page.fill("#set-n", "350")
@@ -115,8 +115,13 @@ def test_a_malformed_message_gets_an_error_and_the_next_good_one_works(page):
 
 
 def test_collisions_toggle_and_download_give_what_they_say(page):
+    page.wait_for_function(
+        "Number(document.querySelector('#readout-collisions').dataset.value) > 0"
+    )
     page.uncheck("#toggle-collisions")
     page.wait_for_function("window.collidiumViewer.status.collisions === false")
+    # The next window of the collision rate counts no collisions at all.
+    page.wait_for_function("document.querySelector('#readout-collisions').dataset.value === '0'")
     with page.expect_download() as download:
         page.click("#download")
     saved = download.value

@@ -5,12 +5,12 @@ from __future__ import annotations
 import json
 
 import pytest
-from starlette.testclient import TestClient
+from starlette.testclient import TestClient, WebSocketDenialResponse
 from starlette.websockets import WebSocketDisconnect
 
 from collidium.presets import preset
 from collidium.viewer import protocol
-from collidium.viewer.server import MAX_CONNECTIONS, STATIC, create_app
+from collidium.viewer.server import MAX_CONNECTIONS, STATIC, create_app, running
 from collidium.viewer.session import ViewerSession
 
 
@@ -46,6 +46,9 @@ def test_nothing_outside_the_static_folder_is_served(client, path):
     assert b"ViewerSession" not in response.content and b"import" not in response.content
 
 
+WS = "ws://127.0.0.1:8765/ws"
+
+
 def receive_json(ws) -> dict:
     while True:
         message = ws.receive()
@@ -54,7 +57,7 @@ def receive_json(ws) -> dict:
 
 
 def test_a_websocket_gets_the_handshake_and_frames(client):
-    with client.websocket_connect("/ws") as ws:
+    with client.websocket_connect(WS) as ws:
         ws.send_text(json.dumps({"type": "ready"}))
         kinds = [receive_json(ws)["type"] for _ in range(4)]
         assert kinds == ["hello", "scene", "status", "stats"]
@@ -63,7 +66,7 @@ def test_a_websocket_gets_the_handshake_and_frames(client):
 
 
 def test_a_malformed_message_gets_an_error_and_the_server_keeps_going(client):
-    with client.websocket_connect("/ws") as ws:
+    with client.websocket_connect(WS) as ws:
         ws.send_text(json.dumps({"type": "ready"}))
         ws.send_text("{this is not json")
         ws.send_bytes(b"\xff\xfe")
@@ -83,7 +86,7 @@ def test_a_malformed_message_gets_an_error_and_the_server_keeps_going(client):
 def test_a_page_from_another_site_cannot_connect(client):
     with (
         pytest.raises(WebSocketDisconnect) as closed,
-        client.websocket_connect("/ws", headers={"origin": "http://evil.example"}) as ws,
+        client.websocket_connect(WS, headers={"origin": "http://evil.example"}) as ws,
     ):
         ws.receive_text()
     assert closed.value.code == 1008
@@ -94,12 +97,54 @@ def test_pages_beyond_the_limit_are_refused_with_a_reason(client):
 
     with contextlib.ExitStack() as stack:
         for _ in range(MAX_CONNECTIONS):
-            ws = stack.enter_context(client.websocket_connect("/ws"))
+            ws = stack.enter_context(client.websocket_connect(WS))
             ws.send_text(json.dumps({"type": "ready"}))
             receive_json(ws)
-        with client.websocket_connect("/ws") as extra:
+        with client.websocket_connect(WS) as extra:
             reply = json.loads(extra.receive_text())
             assert reply["field"] == "connection" and "close one" in reply["reason"]
             with pytest.raises(WebSocketDisconnect) as closed:
                 extra.receive_text()
             assert closed.value.code == 1013
+
+
+def test_a_site_that_rebinds_its_name_to_this_machine_is_refused(client):
+    """DNS rebinding: the attacker's page and name agree with each other, not with us."""
+    headers = {"host": "evil.example:8765", "origin": "http://evil.example:8765"}
+    assert client.get("/", headers={"host": "evil.example:8765"}).status_code == 400
+    with (
+        pytest.raises(WebSocketDenialResponse),
+        client.websocket_connect("ws://evil.example:8765/ws", headers=headers),
+    ):
+        pass
+
+
+def test_a_server_open_to_the_network_accepts_its_own_pages_under_any_name():
+    app = create_app(lambda: ViewerSession(preset("gas", n=5)), hosts=("*",))
+    client = TestClient(app, base_url="http://192.168.1.20:8765")
+    assert client.get("/").status_code == 200
+    origin = {"origin": "http://192.168.1.20:8765"}
+    with client.websocket_connect("ws://192.168.1.20:8765/ws", headers=origin) as ws:
+        ws.send_text(json.dumps({"type": "ready"}))
+        assert receive_json(ws)["type"] == "hello"
+
+
+@pytest.mark.parametrize(
+    "path",
+    ["/static/../server.py", "/static/%2e%2e/server.py", "/static/..%2f..%2fcli.py",
+     "/static//etc/passwd", "/static/%2fetc%2fpasswd"],
+)  # fmt: skip
+def test_raw_paths_never_leave_the_static_folder(path):
+    """Sent byte for byte (http.client does not normalise ``..`` as httpx does)."""
+    import http.client
+    from urllib.parse import urlsplit
+
+    app = create_app(lambda: ViewerSession(preset("gas", n=5)))
+    with running(app) as url:
+        address = urlsplit(url)
+        connection = http.client.HTTPConnection(address.hostname, address.port, timeout=10)
+        connection.request("GET", path)
+        response = connection.getresponse()
+        body = response.read()
+    assert response.status in (400, 404)
+    assert b"import" not in body and b"root:" not in body

@@ -8,6 +8,7 @@ server and the widget move its outgoing items (dicts as JSON, bytes as binary fr
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -24,6 +25,13 @@ MAX_CREDIT = 2
 STATS_PERIOD = 0.2
 #: Computation one tick may spend running the simulation, s (leaves time for 30+ frames/s).
 TICK_BUDGET = 0.02
+#: A front end that has acknowledged nothing for this long, s, with frames outstanding, is not
+#: watching (a hidden tab, a closed notebook view): the simulation waits for it.
+STALL_SECONDS = 1.0
+#: Tokens of the rate limit a message costs: rebuilding the simulation costs more.
+COSTS = {"load": 10, "scenario": 10, "reset": 10}
+
+log = logging.getLogger("collidium.viewer")
 
 
 class Connection:
@@ -41,7 +49,10 @@ class Connection:
         self.session = session
         self.ready = False
         self.frames_sent = 0
+        #: Computation one tick may spend running the simulation, s.
+        self.budget = TICK_BUDGET
         self._clock = clock
+        self._last_ack = clock()
         self._credit = MAX_CREDIT
         self._framed = -1  # session version of the last frame sent
         self._reported = -1  # session version of the last stats sent
@@ -55,16 +66,23 @@ class Connection:
     ) -> list[Outgoing]:
         """Replies to one message; a bad message gets one ``error`` reply and changes nothing."""
         try:
-            message = protocol.parse_message(data)
+            try:
+                message = protocol.parse_message(data)
+            except InputError:
+                self._spend_tokens(1)  # malformed messages count against the rate too
+                raise
             if isinstance(message, protocol.Raw) and not nested:
                 return self.receive(message.text, nested=True)
             if not isinstance(message, protocol.Ack):
-                self._spend_token()
+                self._spend_tokens(COSTS.get(message.type, 1))
             return self._apply(message)
         except InputError as exc:
             return [_error(exc.field, exc.reason)]
         except SimulationError as exc:
             return [_error("run", str(exc)), self.session.status()]
+        except Exception as exc:  # a bug must not end the conversation: report it, go on
+            log.exception("viewer: message %.200r failed", data)
+            return [_error("server", f"internal error ({type(exc).__name__}: {exc})")]
 
     def tick(self) -> list[Outgoing]:
         """Run the simulation for the wall-clock time since the last tick; then the latest frame
@@ -74,11 +92,18 @@ class Connection:
         now = self._clock()
         elapsed = 0.0 if self._last_tick is None else now - self._last_tick
         self._last_tick = now
+        if self._credit == 0 and now - self._last_ack > STALL_SECONDS:
+            return []  # nobody is watching: wait
         out: list[Outgoing] = []
         try:
-            self.session.advance(elapsed, TICK_BUDGET)
+            self.session.advance(elapsed, self.budget)
         except SimulationError as exc:
             out += [_error("run", str(exc)), self.session.status()]
+        except Exception as exc:
+            log.exception("viewer: the simulation failed")
+            self.session.playing = False
+            out += [_error("server", f"internal error ({type(exc).__name__}: {exc})"),
+                    self.session.status()]  # fmt: skip
         if self._credit > 0 and self.session.version != self._framed:
             out.append(self._frame())
         if now - self._last_stats >= STATS_PERIOD and self.session.version != self._reported:
@@ -96,14 +121,14 @@ class Connection:
         self._reported = self.session.version
         return self.session.stats()
 
-    def _spend_token(self) -> None:
+    def _spend_tokens(self, cost: int) -> None:
         now = self._clock()
         rate, burst = protocol.MESSAGES_PER_SECOND, protocol.MESSAGE_BURST
         self._tokens = min(burst, self._tokens + (now - self._refilled) * rate)
         self._refilled = now
-        if self._tokens < 1:
+        if self._tokens < cost:
             raise InputError("message", f"too many messages; at most {rate} per second")
-        self._tokens -= 1
+        self._tokens -= cost
 
     def _apply(self, message: Any) -> list[Outgoing]:
         s = self.session
@@ -116,6 +141,7 @@ class Connection:
         match message:
             case protocol.Ack():
                 self._credit = min(MAX_CREDIT, self._credit + 1)
+                self._last_ack = self._clock()
                 return []
             case protocol.Play() | protocol.Pause():
                 s.playing = isinstance(message, protocol.Play)

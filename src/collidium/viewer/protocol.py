@@ -45,6 +45,8 @@ from collidium.state import FloatArray
 
 #: Most particles a viewer simulates (a scenario asking for more is refused).
 MAX_PARTICLES = 200_000
+#: Most particles with forces between them (the direct pair sum costs N^2 per step).
+MAX_CHARGED_PARTICLES = 5_000
 #: Longest message accepted, in bytes (a scenario's TOML included).
 MAX_MESSAGE_BYTES = 1 << 20
 #: Control messages accepted per second on average (acknowledgements are not counted).
@@ -173,7 +175,7 @@ def parse_message(data: str | bytes | Mapping[str, Any]) -> Message:
             raise InputError("message", f"longer than {MAX_MESSAGE_BYTES} bytes")
         try:
             data = json.loads(data)
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        except (ValueError, RecursionError) as exc:  # bad JSON or encoding, huge or deep values
             raise InputError("message", f"not valid JSON ({exc})") from None
     if not isinstance(data, Mapping):
         raise InputError("message", f"must be a JSON object, got {type(data).__name__}")

@@ -13,13 +13,15 @@ import functools
 import json
 import socket
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
 import anyio.to_thread
 from starlette.applications import Starlette
+from starlette.middleware import Middleware
+from starlette.middleware.trustedhost import TrustedHostMiddleware
 from starlette.requests import Request
 from starlette.responses import FileResponse, Response
 from starlette.routing import Mount, Route, WebSocketRoute
@@ -42,6 +44,9 @@ TICK = 1 / 60
 MAX_CONNECTIONS = 4
 #: Addresses that reach this machine only.
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
+#: Host names a page may use to reach a server listening on this machine only (checked on every
+#: request: a site that rebinds its own name to 127.0.0.1 is refused).
+LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "::1", "[::1]")
 
 
 def check_built(static: Path = STATIC) -> None:
@@ -61,7 +66,11 @@ def check_built(static: Path = STATIC) -> None:
             )
 
 
-def create_app(make_session: Callable[[], ViewerSession], static: Path = STATIC) -> Starlette:
+def create_app(
+    make_session: Callable[[], ViewerSession],
+    static: Path = STATIC,
+    hosts: Sequence[str] = LOOPBACK_HOSTS,
+) -> Starlette:
     """The viewer's application.
 
     Parameters
@@ -70,6 +79,8 @@ def create_app(make_session: Callable[[], ViewerSession], static: Path = STATIC)
         Builds the session of a newly opened page.
     static : Path
         Folder of ``index.html`` and the bundle; nothing outside it is served.
+    hosts : sequence of str
+        Host names requests may be addressed to (``"*"``: any, for a server open to a network).
     """
     open_pages = 0
 
@@ -100,7 +111,8 @@ def create_app(make_session: Callable[[], ViewerSession], static: Path = STATIC)
             Route("/", index),
             WebSocketRoute("/ws", websocket),
             Mount("/static", StaticFiles(directory=static)),
-        ]
+        ],
+        middleware=[Middleware(TrustedHostMiddleware, allowed_hosts=list(hosts))],
     )
 
 
@@ -146,7 +158,7 @@ async def _converse(ws: WebSocket, connection: Connection) -> None:
     finally:
         ticking.cancel()
         with contextlib.suppress(asyncio.CancelledError, Exception):
-            await ticking
+            await ticking  # a send to a page that has gone ends it too
 
 
 def bind(host: str, port: int) -> socket.socket:

@@ -32,6 +32,9 @@ WINDOW_SAMPLES = 5
 MAX_CATCH_UP = 0.25
 #: Main parameters the page offers for a preset, when the preset takes them.
 MAIN_PARAMETERS = ("n", "dt", "k", "collisions")
+#: A step that takes longer than this, in s, pauses the session with an error (dt or N is too
+#: large for a live view).
+MAX_STEP_SECONDS = 2.0
 
 
 class ViewerSession:
@@ -42,8 +45,8 @@ class ViewerSession:
     scenario : Scenario, optional
         What the session builds (and rebuilds on reset); its observers are not run.
     simulation : Simulation, optional
-        A simulation to show as it is (give this or ``scenario``); reset returns to the state it
-        had when the session started.
+        A simulation to show and run in place, its observers included (give this or
+        ``scenario``); reset starts a copy of the state it had when the session started.
     preset : str, optional
         The preset ``scenario`` came from, and ``overrides`` its parameters, shown on the page.
     """
@@ -67,13 +70,15 @@ class ViewerSession:
             self._install(scenario, preset, overrides or {})
         else:
             assert simulation is not None
-            _check_size(simulation.particles.n, "particles")
+            _check_size(simulation.particles.n, bool(simulation.forces), "particles")
+            self._initial = simulation.copy()
             self._start(simulation, None, None, {})
 
     # -- set-up -----------------------------------------------------------------------------
 
     def _install(self, scenario: Scenario, name: str | None, overrides: dict[str, Any]) -> None:
-        _check_size(scenario.particle_count, "n" if "n" in overrides else "particles")
+        field = "n" if "n" in overrides else "particles"
+        _check_size(scenario.particle_count, bool(scenario.forces), field)
         sim = scenario.build()
         sim.observers.clear()
         self._start(sim, scenario, name, overrides)
@@ -89,8 +94,6 @@ class ViewerSession:
         self._scenario = scenario
         self._preset = name
         self._overrides = dict(overrides)
-        if scenario is None:  # keep the starting state for reset and export
-            self._initial = sim.particles.copy()
         self._mode = sim.collisions if sim.collisions != "off" else "exact"
         self._forces = sim.forces
         self.collisions_enabled = sim.collisions != "off"
@@ -98,7 +101,7 @@ class ViewerSession:
         self.traced: int | None = None
         self.generation += 1
         self._carry = 0.0
-        self._seconds_per_step = 1e-3
+        self._seconds_per_step: float | None = None  # measured on the first step
         self._upper_speed = 0.0
         self._changed()
 
@@ -117,9 +120,7 @@ class ViewerSession:
             sim = self._scenario.build()
             sim.observers.clear()
             return sim
-        old = self.sim
-        return Simulation(old.container, self._initial.copy(), forces=self._forces, dt=old.dt,
-                          collisions=self._mode, seed=old.seed, name=old.name)  # fmt: skip
+        return self._initial.copy()
 
     # -- controls ---------------------------------------------------------------------------
 
@@ -203,18 +204,27 @@ class ViewerSession:
             return
         dt = self.sim.dt
         self._carry += min(wall_seconds, MAX_CATCH_UP) * self.speed
-        count = int(self._carry / dt + 1e-9)  # the slack keeps whole multiples whole
-        if count == 0:
+        wanted = self._carry / dt + 1e-9  # the slack keeps whole multiples whole
+        if wanted < 1:
             return
-        affordable = max(1, int(budget / self._seconds_per_step))
-        if count > affordable:
-            count, self._carry = affordable, 0.0
+        per_step = self._seconds_per_step
+        if per_step is None:  # one step first, to learn what a step costs
+            count = 1
+            self._carry -= dt
+        elif wanted >= (affordable := max(1, int(budget / max(per_step, 1e-9)))) + 1:
+            count, self._carry = affordable, 0.0  # more than affordable: run slower than asked
         else:
+            count = int(wanted)
             self._carry -= count * dt
         start = clock.perf_counter()
         self._run(count)
         spent = (clock.perf_counter() - start) / count
-        self._seconds_per_step = 0.7 * self._seconds_per_step + 0.3 * spent
+        self._seconds_per_step = spent if per_step is None else 0.7 * per_step + 0.3 * spent
+        if spent > MAX_STEP_SECONDS:
+            self.playing = False
+            raise SimulationError(
+                f"one step took {spent:.3g} s, too slow to watch; paused: lower N or dt"
+            )
 
     def _run(self, steps: int) -> None:
         try:
@@ -243,6 +253,7 @@ class ViewerSession:
         ]
         limits = {
             "max_particles": protocol.MAX_PARTICLES,
+            "max_charged_particles": protocol.MAX_CHARGED_PARTICLES,
             "speed": list(protocol.SPEED_RANGE),
             "max_message_bytes": protocol.MAX_MESSAGE_BYTES,
             "messages_per_second": protocol.MESSAGES_PER_SECOND,
@@ -277,15 +288,17 @@ class ViewerSession:
         sim = self.sim
         self._sample_window()
         energy = sim.energy()
+        n = sim.particles.n
+        kT = energy.kinetic / n if n else None
         drift = (energy.total - self._reference) / abs(self._reference) if self._reference else None
         return {
-            "type": "stats", "time": sim.time, "steps": sim.steps, "n": sim.particles.n,
-            "temperature": _number(sim.temperature()), "pressure": self._pressure,
+            "type": "stats", "time": sim.time, "steps": sim.steps, "n": n,
+            "temperature": _number(kT), "pressure": self._pressure,
             "pressure_kind": "virial" if sim.container.periodic else "wall",
             "collision_rate": self._rate, "drift": _number(drift),
-            "energy": {"kinetic": energy.kinetic, "potential": energy.potential,
-                       "total": energy.total},
-            "total_speed": sim.total_speed(), "histogram": self._histogram(),
+            "energy": {"kinetic": _number(energy.kinetic), "potential": _number(energy.potential),
+                       "total": _number(energy.total)},
+            "total_speed": _number(sim.total_speed()), "histogram": self._histogram(kT),
         }  # fmt: skip
 
     def _sample_window(self) -> None:
@@ -310,12 +323,11 @@ class ViewerSession:
         self._window = (sim.time, sim.counters.pair_collisions)
         self._thermo.compute(sim)
 
-    def _histogram(self) -> dict[str, Any]:
+    def _histogram(self, kT: float | None) -> dict[str, Any]:
         sim = self.sim
-        kT = sim.temperature()
-        if not kT > 0:
+        scale = math.sqrt(kT / float(sim.particles.mass.min())) if kT and kT > 0 else math.nan
+        if not math.isfinite(scale) or scale == 0:
             return {"edges": [], "density": [], "maxwell_boltzmann": None}
-        scale = math.sqrt(kT / float(sim.particles.mass.min()))
         if not scale * 4 <= self._upper_speed <= scale * 10:
             self._upper_speed = _nice_ceiling(5 * scale)
         histogram = SpeedHistogram(HISTOGRAM_BINS, (0.0, self._upper_speed)).compute(sim)
@@ -339,9 +351,13 @@ class ViewerSession:
         return {"type": "export", "filename": f"{filename}.toml", "toml": scenario.to_toml()}
 
 
-def _check_size(n: int, field: str) -> None:
-    if n > protocol.MAX_PARTICLES:
-        raise InputError(field, f"{n} particles; the viewer takes at most {protocol.MAX_PARTICLES}")
+def _check_size(n: int, forces: bool, field: str) -> None:
+    """Refuse more particles than a live view can run (fewer with forces: their pair sum is
+    O(N^2) per step)."""
+    most = protocol.MAX_CHARGED_PARTICLES if forces else protocol.MAX_PARTICLES
+    if n > most:
+        what = " with forces" if forces else ""
+        raise InputError(field, f"{n} particles; the viewer takes at most {most}{what}")
 
 
 def _compact(values: FloatArray) -> float | list[float]:
