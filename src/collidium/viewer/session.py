@@ -96,8 +96,6 @@ class ViewerSession:
         self._overrides = dict(overrides)
         self._mode = sim.collisions if sim.collisions != "off" else "exact"
         self._forces = sim.forces
-        self.collisions_enabled = sim.collisions != "off"
-        self.charges_enabled = bool(sim.forces)
         self.traced: int | None = None
         self.generation += 1
         self._carry = 0.0
@@ -160,7 +158,6 @@ class ViewerSession:
 
     def enable_collisions(self, enabled: bool) -> None:
         """Collisions between disks on (the scenario's mode) or off (walls still reflect)."""
-        self.collisions_enabled = enabled
         self.sim.collisions = self._mode if enabled else "off"
         self._changed()
 
@@ -168,7 +165,6 @@ class ViewerSession:
         """The scenario's forces on or off."""
         if enabled and not self._forces:
             raise InputError("charges", "this scenario has no forces to switch on")
-        self.charges_enabled = enabled
         self.sim.forces = self._forces if enabled else ()
         self._changed()
 
@@ -183,6 +179,16 @@ class ViewerSession:
         self._check_index(index)
         self.sim.particles.velocity[index] = (vx, vy)
         self._changed()
+
+    @property
+    def collisions_enabled(self) -> bool:
+        """Whether disks collide with each other."""
+        return self.sim.collisions != "off"
+
+    @property
+    def charges_enabled(self) -> bool:
+        """Whether the scenario's forces act."""
+        return bool(self.sim.forces)
 
     def _check_index(self, index: int) -> None:
         n = self.sim.particles.n
