@@ -1,13 +1,17 @@
-"""Core benchmarks (issue: core simulator). Run: ``python benchmarks/bench_core.py [--quick]``.
+"""Scale and speed benchmarks, beside REBOUND and pymunk where installed (``pip install .[bench]``).
 
-W1  exact hard-disk gas at packing fraction 0.3: pair collisions per second (one core), N = 1e3,
-    1e4, 1e5, beside the all-pairs NumPy twin at the smallest N.
-W2  charged gas, N = 2000: Coulomb pair interactions per second (numba direct sum on all cores),
-    beside the NumPy twin.
-W3  pool-break, 60 simulated seconds: wall-clock seconds.
+Run: ``python benchmarks/bench_core.py [--quick]``. Prints a table and writes
+``benchmarks/results/core.json``. Every timing follows a warm-up run, so compilation is not counted.
 
-Prints a table and writes ``benchmarks/results/core.json``. Timings are taken after a warm-up run
-so that compilation is not counted.
+W1  exact hard-disk gas at packing 0.3 (one core): pair collisions per second, N = 1e3 .. 1e6; the
+    all-pairs NumPy twin at N = 1e3; REBOUND hard spheres with its tree collision search.
+W1s ``step`` mode, same gas, dt = 0.01 s (all cores): particle-steps per second; pymunk balls in a
+    box at the same N and dt.
+W2  charged gas (all cores): microseconds per particle-step of the Coulomb sum, direct and tree,
+    N = 200 .. 1e6, with the tree's RMS relative force error; direct pair interactions per second;
+    REBOUND direct ("basic") and tree gravity at equal N.
+W3  the seed report's scenes (every preset): wall seconds per simulated second.
+M   peak resident memory of an exact run at N = 1e6, and per particle.
 """
 
 from __future__ import annotations
@@ -16,37 +20,53 @@ import argparse
 import json
 import math
 import platform
+import subprocess
+import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numba
 import numpy as np
 
 import collidium as cd
+from collidium.forces import TREE_CROSSOVER
 from collidium.initial import random_positions
-from collidium.kernels import reference
+from collidium.kernels import reference, tree
 from collidium.kernels.pairwise import coulomb_direct
+from collidium.presets import PRESETS, preset
+
+sys.path.insert(0, str(Path(__file__).parent))
+import peers
 
 RESULTS = Path(__file__).parent / "results"
+PACKING = 0.3
+RADIUS = 0.25
 
 
-def packed_gas(n: int, packing: float = 0.3, radius: float = 0.25, seed: int = 1) -> cd.Simulation:
-    """N disks at the given packing fraction in a square reflecting box, speeds ~ 1 m/s."""
-    side = math.sqrt(n * math.pi * radius**2 / packing)
+def packed_gas(
+    n: int,
+    packing: float = PACKING,
+    radius: float = RADIUS,
+    seed: int = 1,
+    collisions: str = "exact",
+    dt: float = 1.0,
+) -> cd.Simulation:
+    """N disks at the given packing fraction in a square reflecting box, velocities N(0, 1) m/s."""
+    side = peers.gas_box_side(n, packing, radius)
     rng = np.random.default_rng(seed)
     position = random_positions(n, np.full(n, radius), side, side, rng)
     velocity = rng.normal(0.0, 1.0, (n, 2))
-    return cd.Simulation(
-        cd.Box(side, side), cd.Particles(position, velocity, radius=radius), dt=1.0
-    )
+    particles = cd.Particles(position, velocity, radius=radius)
+    return cd.Simulation(cd.Box(side, side), particles, dt=dt, collisions=collisions)  # type: ignore[arg-type]
 
 
-def collisions_per_second(n: int, target: int) -> dict[str, float]:
-    """W1: time the exact engine until about ``target`` pair collisions."""
+def exact_collisions_per_second(n: int, target: float) -> dict[str, Any]:
+    """W1: time the exact engine (one thread) over about ``target`` pair collisions."""
     sim = packed_gas(n)
-    sim.run(steps=1)  # warm-up, compile, relax the lattice-free start
-    rate_estimate = max(sim.counters.pair_collisions, 1) / sim.dt
-    sim.dt = max(target / rate_estimate, 1e-3)
+    sim.dt = 0.2
+    sim.run(steps=1)  # warm-up: compile, build the queue, relax the random start
+    sim.dt = max(target / max(sim.counters.pair_collisions / 0.2, 1.0), 1e-3)
     before = sim.counters.pair_collisions
     start = time.perf_counter()
     sim.run(steps=1)
@@ -55,87 +75,260 @@ def collisions_per_second(n: int, target: int) -> dict[str, float]:
     return {"n": n, "collisions": done, "seconds": seconds, "per_second": done / seconds}
 
 
-def reference_collisions_per_second(n: int, duration: float) -> float:
+def numpy_twin_collisions_per_second(n: int, duration: float) -> float:
     """W1 peer: the NumPy twin (all pairs at every event) on the same kind of gas."""
     sim = packed_gas(n)
     p = sim.particles
-    position, velocity = p.position.copy(), p.velocity.copy()
     half = 0.5 * sim.container.size
     start = time.perf_counter()
-    pairs, *_ = reference.event_drift(position, velocity, p.mass, p.radius, half, duration)
+    pairs, *_ = reference.event_drift(p.position, p.velocity, p.mass, p.radius, half, duration)
     return pairs / (time.perf_counter() - start)
 
 
-def pair_interactions_per_second(n: int, repeats: int) -> dict[str, float]:
-    """W2: Coulomb direct sum, N (N - 1) pair terms per evaluation, numba and NumPy."""
-    sim = cd.load("charged-gas", n=n, width=200.0, height=200.0)
-    p = sim.particles
-    force, energy, virial = np.empty((n, 2)), np.empty(n), np.empty(n)
-
-    def kernel() -> None:
-        coulomb_direct(p.position, p.charge, 5.0, 0.0, 0.0, 0.0, False, force, energy, virial)
-
-    kernel()
+def step_mode_particle_steps(n: int, steps: int) -> dict[str, Any]:
+    """W1s: the seed's step mode at dt = 0.01 s, all cores."""
+    sim = packed_gas(n, collisions="step", dt=0.01)
+    sim.run(steps=2)
     start = time.perf_counter()
-    for _ in range(repeats):
-        kernel()
-    per_eval = (time.perf_counter() - start) / repeats
-    start = time.perf_counter()
-    reference.coulomb_direct(p.position, p.charge, 5.0, 0.0)
-    per_eval_numpy = time.perf_counter() - start
-    pairs = n * (n - 1)
-    return {
-        "n": n,
-        "threads": numba.get_num_threads(),
-        "per_second": pairs / per_eval,
-        "numpy_per_second": pairs / per_eval_numpy,
-    }
-
-
-def pool_break_seconds(simulated: float) -> dict[str, float]:
-    """W3: wall seconds for the pool-break preset (exact collisions, dt = 0.01 s reports)."""
-    cd.load("pool-break").run(time=0.1)  # warm-up
-    sim = cd.load("pool-break")
-    start = time.perf_counter()
-    sim.run(time=simulated)
+    sim.run(steps=steps)
     seconds = time.perf_counter() - start
     return {
-        "simulated_seconds": simulated,
-        "wall_seconds": seconds,
-        "collisions": sim.counters.pair_collisions,
-        "escaped": sim.escaped(),
+        "n": n,
+        "steps": steps,
+        "seconds": seconds,
+        "per_second": n * steps / seconds,
+        "threads": numba.get_num_threads(),
     }
+
+
+def charged_gas(n: int, seed: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Positions uniform in a square (density 0.25 per m^2) and alternating +1/-1 charges."""
+    side = math.sqrt(n / 0.25)
+    rng = np.random.default_rng(seed)
+    position = rng.uniform(-side / 2, side / 2, (n, 2))
+    charge = np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    return position, charge
+
+
+def _best_of(repeats: int, call: Any) -> float:
+    call()
+    best = math.inf
+    for _ in range(repeats):
+        start = time.perf_counter()
+        call()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def coulomb_costs(n: int, with_direct: bool, error_targets: int) -> dict[str, Any]:
+    """W2: seconds per force evaluation, direct and tree, and the tree's RMS relative error
+    against direct summation over ``error_targets`` particles (all of them when fewer)."""
+    position, charge = charged_gas(n)
+    out: dict[str, Any] = {"n": n, "threads": numba.get_num_threads(), "theta": tree.THETA}
+    force = np.empty((n, 2))
+    energy, virial = np.empty(n), np.empty(n)
+    repeats = max(1, min(20, int(2e6 / n)))
+    buffers = tree.tree_buffers(n)
+
+    def by_tree() -> None:
+        tree.coulomb_tree(position, charge, 5.0, 0.0, force, energy, virial, buffers)
+
+    out["tree_seconds"] = _best_of(repeats, by_tree)
+    if with_direct:
+
+        def direct() -> None:
+            coulomb_direct(position, charge, 5.0, 0.0, 0.0, 0.0, False, force, energy, virial)
+
+        out["direct_seconds"] = _best_of(max(1, repeats // 4), direct)
+        out["direct_pairs_per_second"] = n * (n - 1) / out["direct_seconds"]
+    by_tree()
+    targets = np.random.default_rng(2).choice(n, size=min(n, error_targets), replace=False)
+    exact = reference.coulomb_direct_on(position, charge, 5.0, 0.0, targets)
+    error = np.linalg.norm(force[targets] - exact, axis=1) / np.linalg.norm(exact, axis=1)
+    out["tree_rms_relative_error"] = float(np.sqrt(np.mean(error**2)))
+    return out
+
+
+def seed_scene_costs() -> list[dict[str, Any]]:
+    """W3: every preset, wall seconds per simulated second over its own duration (capped)."""
+    rows = []
+    for name in PRESETS:
+        duration = min(preset(name).run.time, 10.0)
+        cd.load(name).run(steps=2)  # warm-up
+        sim = cd.load(name)
+        start = time.perf_counter()
+        sim.run(time=duration)
+        seconds = time.perf_counter() - start
+        rows.append(
+            {
+                "scene": name,
+                "n": sim.particles.n,
+                "simulated_seconds": duration,
+                "wall_seconds": seconds,
+                "wall_per_simulated": seconds / duration,
+            }
+        )
+    return rows
+
+
+# VmHWM, not ru_maxrss: a child's ru_maxrss starts from its parent's at the fork.
+_MEMORY_PROGRAM = """
+import sys
+sys.path.insert(0, {here!r})
+from bench_core import packed_gas
+sim = packed_gas({n}, dt=0.05)
+sim.run(steps=3)
+status = open("/proc/self/status").read().split("VmHWM:")[1]
+print(int(status.split()[0]) * 1024)
+"""
+
+
+def peak_memory(n: int) -> int:
+    """Peak resident bytes of a fresh process that builds an N-disk gas and runs it exactly."""
+    program = _MEMORY_PROGRAM.format(here=str(Path(__file__).parent), n=n)
+    done = subprocess.run(
+        [sys.executable, "-c", program], capture_output=True, text=True, check=True
+    )
+    return int(done.stdout.split()[-1])
+
+
+def _ratio(ours: float, theirs: float | None) -> str:
+    return f"{ours / theirs:,.1f}x" if theirs else ""
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="smaller sizes, for a smoke test")
+    parser.add_argument("--no-peers", action="store_true", help="skip REBOUND and pymunk")
     args = parser.parse_args()
-    sizes = [1_000, 10_000] if args.quick else [1_000, 10_000, 100_000]
-    target = 50_000 if args.quick else 1_000_000
+    quick = args.quick
+    have = {} if args.no_peers else peers.available()
+    print(
+        f"collidium {cd.__version__}, numba {numba.__version__}, {numba.get_num_threads()} "
+        f"threads, {platform.machine()}; peers: {have}"
+    )
+    rows: list[tuple[str, str, str, str]] = []
+    out: dict[str, Any] = {"numba": numba.__version__, "peers": have}
 
-    w1 = [collisions_per_second(n, target) for n in sizes]
-    numpy_rate = reference_collisions_per_second(1_000, 0.2)
-    w2 = pair_interactions_per_second(2_000, 5 if args.quick else 50)
-    w3 = pool_break_seconds(6.0 if args.quick else 60.0)
-
-    print(f"collidium {cd.__version__}, numba {numba.__version__}, {platform.processor() or ''}")
-    print(f"{'workload':<40}{'figure':>16}{'vs NumPy twin':>16}")
+    sizes = [1_000, 10_000] if quick else [1_000, 10_000, 100_000, 1_000_000]
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    w1 = [exact_collisions_per_second(n, 2e5 if quick else 2e6) for n in sizes]
+    numba.set_num_threads(threads)
+    twin = numpy_twin_collisions_per_second(1_000, 0.2)
+    out["w1_exact_gas"] = w1
+    out["w1_numpy_twin_per_second"] = twin
+    rebound_gas = {}
+    if have.get("rebound"):
+        for n in sizes[:3]:
+            rebound_gas[n] = peers.rebound_hard_disks(n, PACKING, RADIUS)
+    out["w1_rebound"] = list(rebound_gas.values())
     for row in w1:
-        ratio = f"{row['per_second'] / numpy_rate:,.0f}x" if row["n"] == 1_000 else ""
-        label = f"W1 exact gas N={row['n']:,} coll/s"
-        print(f"{label:<40}{row['per_second']:>16,.0f}{ratio:>16}")
-    print(f"{'W1 NumPy twin N=1,000 coll/s':<40}{numpy_rate:>16,.0f}")
-    label = f"W2 Coulomb N={w2['n']:,} pairs/s ({w2['threads']} thr)"
-    ratio = f"{w2['per_second'] / w2['numpy_per_second']:,.1f}x"
-    print(f"{label:<40}{w2['per_second']:>16,.3g}{ratio:>16}")
-    label = f"W3 pool-break {w3['simulated_seconds']:g} s simulated, wall s"
-    print(f"{label:<40}{w3['wall_seconds']:>16.2f}")
+        n = row["n"]
+        theirs = rebound_gas.get(n, {}).get("collisions_per_second")
+        peer = f"REBOUND {theirs:,.0f}" if theirs else ("NumPy twin" if n == 1_000 else "")
+        ratio = _ratio(row["per_second"], theirs) if theirs else ""
+        rows.append(
+            (f"W1 exact gas N={n:,} (1 core)", f"{row['per_second']:,.3g} coll/s", peer, ratio)
+        )
+    rows.append(
+        (
+            "W1 NumPy twin N=1,000",
+            f"{twin:,.3g} coll/s",
+            "",
+            f"ours {w1[0]['per_second'] / twin:,.0f}x",
+        )
+    )
 
+    step_sizes = [10_000, 100_000] if quick else [10_000, 100_000, 1_000_000]
+    w1s = [step_mode_particle_steps(n, 20 if n >= 1e6 else 50) for n in step_sizes]
+    out["w1_step_mode"] = w1s
+    munk = {}
+    if have.get("pymunk"):
+        for n in step_sizes:
+            munk[n] = peers.pymunk_balls(n, PACKING, RADIUS, dt=0.01)
+    out["w1_pymunk"] = list(munk.values())
+    for row in w1s:
+        theirs = munk.get(row["n"], {}).get("particle_steps_per_second")
+        rows.append(
+            (
+                f"W1s step mode N={row['n']:,} ({row['threads']} thr)",
+                f"{row['per_second']:,.3g} p-steps/s",
+                f"pymunk {theirs:,.3g}" if theirs else "",
+                _ratio(row["per_second"], theirs),
+            )
+        )
+
+    charged = [200, 1_000, 10_000] if quick else [200, 1_000, 5_000, 10_000, 100_000, 1_000_000]
+    w2 = [coulomb_costs(n, with_direct=n <= 100_000, error_targets=1000) for n in charged]
+    out["w2_coulomb"] = w2
+    out["w2_auto_crossover"] = TREE_CROSSOVER
+    gravity: dict[tuple[int, str], dict[str, Any]] = {}
+    if have.get("rebound"):
+        for n in charged:
+            if n <= 10_000:
+                gravity[(n, "basic")] = peers.rebound_gravity(n, method="basic")
+            if n <= 100_000 or not quick:
+                gravity[(n, "tree")] = peers.rebound_gravity(n, method="tree")
+    out["w2_rebound"] = [dict(v, method=k[1]) for k, v in gravity.items()]
+    for row in w2:
+        n = row["n"]
+        if "direct_seconds" in row:
+            ours = row["direct_seconds"] / n * 1e6
+            theirs = gravity.get((n, "basic"), {}).get("us_per_particle_step")
+            rows.append(
+                (
+                    f"W2 direct N={n:,} ({row['threads']} thr)",
+                    f"{ours:,.3g} us/p-step; {row['direct_pairs_per_second']:,.3g} pairs/s",
+                    f"REBOUND basic {theirs:,.3g}" if theirs else "",
+                    _ratio(theirs, ours) if theirs else "",
+                )
+            )
+        ours = row["tree_seconds"] / n * 1e6
+        theirs = gravity.get((n, "tree"), {}).get("us_per_particle_step")
+        rows.append(
+            (
+                f"W2 tree N={n:,} (theta {row['theta']})",
+                f"{ours:,.3g} us/p-step; err {row['tree_rms_relative_error']:.1e}",
+                f"REBOUND tree {theirs:,.3g}" if theirs else "",
+                _ratio(theirs, ours) if theirs else "",
+            )
+        )
+
+    w3 = seed_scene_costs()
+    out["w3_seed_scenes"] = w3
+    for row in w3:
+        rows.append(
+            (
+                f"W3 {row['scene']} (N={row['n']})",
+                f"{row['wall_per_simulated']:.3g} wall s / sim s",
+                "",
+                "",
+            )
+        )
+
+    small, large = peak_memory(1_000), peak_memory(100_000 if quick else 1_000_000)
+    big_n = 100_000 if quick else 1_000_000
+    per_particle = (large - small) / (big_n - 1_000)
+    out["memory"] = {
+        "peak_bytes_n1000": small,
+        f"peak_bytes_n{big_n}": large,
+        "bytes_per_particle": per_particle,
+    }
+    rows.append(
+        (
+            f"M peak RSS exact run N={big_n:,}",
+            f"{large / 2**20:,.0f} MB",
+            f"N=1,000: {small / 2**20:,.0f} MB",
+            f"{per_particle:,.0f} B/particle",
+        )
+    )
+
+    print(f"{'workload':<40}{'collidium':>40}{'peer':>26}{'ratio':>12}")
+    for label, ours_text, peer_text, ratio_text in rows:
+        print(f"{label:<40}{ours_text:>40}{peer_text:>26}{ratio_text:>12}")
     RESULTS.mkdir(exist_ok=True)
-    out = {"w1_exact_gas": w1, "w1_numpy_twin_per_second": numpy_rate, "w2_coulomb": w2,
-           "w3_pool_break": w3, "numba": numba.__version__}  # fmt: skip
-    (RESULTS / "core.json").write_text(json.dumps(out, indent=2))
+    (RESULTS / "core.json").write_text(json.dumps(out, indent=2, default=float))
 
 
 if __name__ == "__main__":

@@ -23,7 +23,7 @@ import numpy as np
 from collidium.containers import Box
 from collidium.errors import SimulationError
 from collidium.kernels import events, stepper, walls
-from collidium.kernels.cells import grid_shape, neighbour_table
+from collidium.kernels.cells import event_grid_shape, grid_shape, neighbour_table
 from collidium.state import FloatArray, IntArray, Particles
 
 CollisionMode = Literal["exact", "step", "off"]
@@ -172,11 +172,67 @@ class StepCollisions(_Stateless):
 
     A collision is only detected if the disks overlap at the end of a step, so fast or small disks
     can pass through each other; energy is still conserved by each resolved collision.
+
+    The pair search keeps the particles sorted into a cell grid of its own
+    (`stepper.step_grid`), updated from step to step; the grid is kept while the number of
+    particles and the box stay the same and no disk grows past the diameter it was made for.
+    Its arrays take about 90 bytes per particle.
     """
 
+    #: Bands of rows searched in parallel (at most one per row of cells).
+    SEARCH_CHUNKS = 256
+
     def __init__(self) -> None:
-        self._grid: _Grid | None = None
-        self._pairs = np.empty(64, dtype=np.int64)
+        self._layout: tuple[int, float, float, bool] | None = None
+        self._diameter = 0.0
+        self._sorted = False  # whether the cell order of the step before is at hand
+        self._radius = np.empty(0)  # the radii seen at the step before
+        self._pairs = np.empty(0, dtype=np.int64)
+        self._scratch = np.empty(0, dtype=np.int64)
+
+    def _make_grid(self, particles: Particles, box: Box, diameter: float) -> None:
+        n = particles.n
+        self._layout = (n, box.width, box.height, box.periodic)
+        self._diameter = diameter
+        self._sorted = False
+        ncx, ncy, self._general = stepper.step_grid(
+            box.width, box.height, diameter, n, box.periodic
+        )
+        self._shape = (ncx, ncy)
+        self._chunks = min(self.SEARCH_CHUNKS, ncy)
+        index = np.int32 if max(n, ncx * ncy) < 2**31 - 1 else np.int64
+        self._start = np.empty(ncx * ncy + 1, dtype=index)
+        self._cursor = np.empty(ncx * ncy, dtype=index)
+        self._order, self._order_out = np.empty(n, index), np.empty(n, index)
+        self._key, self._key_out = np.empty(n, index), np.empty(n, index)
+        self._new_key = np.empty(n, dtype=index)
+        self._movers = np.empty(n, dtype=index)
+        self._moved = np.empty(stepper.chunk_count(n), dtype=np.int64)
+        self._data_xy, self._cell_xy = np.empty((n, 2)), np.empty((n, 2))
+        self._data_r, self._cell_r = np.empty(n), np.empty(n)
+        if self._pairs.shape[0] < self._chunks * 64:
+            self._pairs = np.empty(self._chunks * max(64, n // (8 * self._chunks)), dtype=np.int64)
+            self._scratch = np.empty_like(self._pairs)
+
+    def _sort(self, particles: Particles, box: Box, fresh: bool, uniform: bool) -> None:
+        """Sort the particles into cells (from last step's order when there is one)."""
+        if self._sorted:
+            self._sorted = stepper.update_cells(
+                particles.position, particles.radius, fresh, uniform, box.width, box.height,
+                *self._shape, self._order, self._key, self._data_xy, self._data_r,
+                self._new_key, self._movers, self._moved, self._order_out, self._key_out,
+                self._start, self._cell_xy, self._cell_r,
+            )  # fmt: skip
+            if self._sorted:
+                self._order, self._order_out = self._order_out, self._order
+                self._key, self._key_out = self._key_out, self._key
+                return
+        stepper.sort_into_cells(
+            particles.position, particles.radius, uniform, box.width, box.height, *self._shape,
+            self._movers, self._data_xy, self._data_r, self._cursor, self._order, self._key,
+            self._start, self._cell_xy, self._cell_r,
+        )  # fmt: skip
+        self._sorted = True
 
     def drift(
         self,
@@ -189,17 +245,26 @@ class StepCollisions(_Stateless):
     ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
         _free_flight(particles, box, dt, tally)
-        if self._grid is None or self._grid.cell_of.shape[0] != particles.n:
-            self._grid = _Grid(particles, box)
-        g = self._grid
+        if particles.n == 0:
+            return
+        if self._radius.shape[0] != particles.n:
+            self._radius = np.full(particles.n, np.nan)
+        changed, uniform, largest = stepper.radius_summary(particles.radius, self._radius)
+        layout = (particles.n, box.width, box.height, box.periodic)
+        # Cells must stay at least a diameter wide; they are kept if the disks shrink.
+        if layout != self._layout or 2.0 * largest > self._diameter:
+            self._make_grid(particles, box, 2.0 * largest)
+        self._sort(particles, box, changed, uniform)
         while True:
             count = stepper.overlapping_pairs(
-                particles.position, particles.radius, box.width, box.height, *g.shape,
-                g.cell_of, g.head, g.next, g.prev, g.cells, g.shifts, self._pairs,
+                self._start, self._order, self._cell_xy, self._cell_r, uniform,
+                float(particles.radius[0]), *self._shape, box.width, box.height, box.periodic,
+                self._general, self._chunks, self._pairs, self._scratch,
             )  # fmt: skip
-            if count <= self._pairs.shape[0]:
+            if count >= 0:
                 break
-            self._pairs = np.empty(2 * count, dtype=np.int64)
+            self._pairs = np.empty(2 * self._chunks * -count, dtype=np.int64)
+            self._scratch = np.empty_like(self._pairs)
         tally.counts[0] += stepper.resolve_pairs(
             self._pairs[:count], particles.position, particles.velocity, particles.mass,
             box.width, box.height, box.periodic, tally.impulse,
@@ -209,75 +274,81 @@ class StepCollisions(_Stateless):
 class ExactCollisions:
     """Event-driven drift: exact collision times and exact elastic responses.
 
-    The engine keeps lazily updated positions of its own; ``particles.position`` receives the
-    positions at the end of each drift. If the particles' positions or velocities differ from what
-    the engine last wrote (a force kick, an edit by the user), the queue is rebuilt from them.
+    The engine keeps lazily updated positions of its own, in its own order
+    (`collidium.kernels.events`); ``particles.position`` and ``particles.velocity`` receive the
+    state at the end of each drift. If the particles differ from what the engine last wrote (a
+    force kick, an edit by the user), the queue is rebuilt from them.
     """
 
     def __init__(self) -> None:
         self._state: dict[str, np.ndarray] | None = None
-        self._written: FloatArray | None = None  # positions last written to the particles
+        self._synced_at = 0.0  # time (s) at which the particles were last written
         #: Events processed so far (collisions, wall hits, cell crossings, stale events).
         self.events = 0
         #: Times the event queue was built from scratch.
         self.rebuilds = 0
+        #: Events per particle between re-sorts of the engine's memory by cell (speed only).
+        self.sort_interval = events.SORT_INTERVAL
 
     def state(self) -> dict[str, np.ndarray]:
         """The event queue and lazily updated positions, and the event counters."""
         out: dict[str, np.ndarray] = {
             "events": np.array([self.events, self.rebuilds], dtype=np.int64)
         }
-        if self._state is not None and self._written is not None:
+        if self._state is not None:
             out |= {f"queue/{name}": array for name, array in self._state.items()}
-            out["written"] = self._written
+            out["synced_at"] = np.array([self._synced_at])
         return out
 
     def load_state(self, arrays: dict[str, np.ndarray]) -> None:
-        """Continue from a saved queue (or rebuild it at the next drift if none was saved)."""
+        """Continue from a saved queue (or rebuild it at the next drift if none was saved, or
+        one of another layout)."""
         self.events, self.rebuilds = (int(x) for x in arrays["events"])
         queue = {k.removeprefix("queue/"): v for k, v in arrays.items() if k.startswith("queue/")}
-        self._state = {name: np.array(array) for name, array in queue.items()} or None
-        self._written = np.array(arrays["written"]) if "written" in arrays else None
+        usable = set(queue) == set(_QUEUE_ARRAYS) and "synced_at" in arrays
+        self._state = {name: np.array(queue[name]) for name in _QUEUE_ARRAYS} if usable else None
+        self._synced_at = float(arrays["synced_at"][0]) if usable else 0.0
 
     def _is_current(self, particles: Particles) -> bool:
-        return (
-            self._state is not None
-            and self._written is not None
-            and np.array_equal(self._written, particles.position)
-            and np.array_equal(self._state["velocity"], particles.velocity)
-            and np.array_equal(self._state["radius"], particles.radius)
+        s = self._state
+        if s is None or s["body"].shape[0] != particles.n:
+            return False
+        p = particles
+        return bool(
+            events.matches(
+                self._synced_at, s["body"], s["ident"], p.position, p.velocity, p.radius, p.mass
+            )
         )
 
     def _rebuild(self, particles: Particles, box: Box, now: float) -> dict[str, np.ndarray]:
         n = particles.n
-        grid = _Grid(particles, box)
-        ncx, ncy = grid.shape
-        s = {
-            "position": particles.position.copy(),
-            "velocity": particles.velocity.copy(),
-            "radius": particles.radius.copy(),  # what the queue was predicted with
-            "stamp": np.empty(n),
+        diameter = 2.0 * float(particles.radius.max(initial=0.0))
+        ncx, ncy = event_grid_shape(box.width, box.height, diameter, n)
+        index = np.int32
+        s: dict[str, np.ndarray] = {
+            "body": np.empty((n, events.BODY_COLUMNS)),
+            "ident": np.empty(n, dtype=index),
             "geometry": np.array(
                 [0.5 * box.width, 0.5 * box.height, box.width / ncx, box.height / ncy]
             ),
             "grid": np.array([ncx, ncy, int(box.periodic)], dtype=np.int64),
-            "cell_of": grid.cell_of, "head": grid.head, "next": grid.next, "prev": grid.prev,
-            "cells": grid.cells, "shifts": grid.shifts,
-            "collisions": np.zeros(n, dtype=np.int64),
-            "event_time": np.empty(n),
-            "event_kind": np.empty(n, dtype=np.int64),
-            "event_other": np.empty(n, dtype=np.int64),
-            "event_stamp": np.empty(n, dtype=np.int64),
-            "heap": np.empty(n, dtype=np.int64),
-            "heap_keys": np.empty(n),
-            "heap_where": np.empty(n, dtype=np.int64),
-        }  # fmt: skip
-        events.rebuild(
-            now, s["position"], s["velocity"], s["stamp"], particles.radius, s["geometry"],
-            s["grid"], s["cell_of"], s["head"], s["next"], s["prev"], s["cells"], s["shifts"],
-            s["collisions"], s["event_time"], s["event_kind"], s["event_other"],
-            s["event_stamp"], s["heap"], s["heap_keys"], s["heap_where"],
+            "cell_of": np.empty(n, dtype=index),
+            "head": np.empty(ncx * ncy, dtype=index),
+            "next": np.empty(n, dtype=index),
+            "prev": np.empty(n, dtype=index),
+            "count": np.empty(n, dtype=index),
+            "event": np.empty((n, events.EVENT_COLUMNS), dtype=index),
+            "keys": np.empty(n),
+            "items": np.empty(n, dtype=index),
+            "where": np.empty(n, dtype=index),
+            "order": np.empty(n, dtype=index),
+            "scratch": np.empty(n),
+        }
+        events.load(
+            particles.position, particles.velocity, particles.radius, particles.mass,
+            s["body"], s["ident"],
         )  # fmt: skip
+        events.rebuild(now, *(s[name] for name in _QUEUE_ARRAYS))
         return s
 
     def drift(
@@ -298,22 +369,27 @@ class ExactCollisions:
         assert s is not None
         until = now + dt
         processed = events.run_events(
-            until, s["position"], s["velocity"], s["stamp"], particles.mass, particles.radius,
-            particles.image, s["geometry"], s["grid"], s["cell_of"], s["head"], s["next"],
-            s["prev"], s["cells"], s["shifts"], s["collisions"], s["event_time"],
-            s["event_kind"], s["event_other"], s["event_stamp"], s["heap"], s["heap_keys"],
-            s["heap_where"], tally.counts, tally.impulse,
+            until, s["body"], s["ident"], particles.image, s["geometry"], s["grid"], s["cell_of"],
+            s["head"], s["next"], s["prev"], s["count"], s["event"], s["keys"], s["items"],
+            s["where"], s["order"], s["scratch"], tally.counts, tally.impulse,
             _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
+            max(1, self.sort_interval * particles.n),
         )  # fmt: skip
         if processed < 0:
             self._state = None  # the queue is unusable; a later drift rebuilds it
             stuck = -1 - processed
             raise SimulationError(
                 f"particle {stuck}: time stopped advancing in the event-driven drift near "
-                f"t = {until:.6g} s (velocity {s['velocity'][stuck].tolist()} m/s); "
-                "the state has run away: try a smaller dt or softening"
+                f"t = {until:.6g} s (velocity {particles.velocity[stuck].tolist()} m/s at the "
+                "step's start); the state has run away: try a smaller dt or softening"
             )
         self.events += processed
-        events.synchronise(until, s["position"], s["velocity"], s["stamp"], particles.position)
-        particles.velocity[...] = s["velocity"]
-        self._written = particles.position.copy()
+        events.synchronise(until, s["body"], s["ident"], particles.position, particles.velocity)
+        self._synced_at = until
+
+
+#: The engine's arrays in the order `events.rebuild` and `events.run_events` take them.
+_QUEUE_ARRAYS = (
+    "body", "ident", "geometry", "grid", "cell_of", "head", "next", "prev", "count", "event",
+    "keys", "items", "where", "order", "scratch",
+)  # fmt: skip

@@ -5,13 +5,25 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
 from collidium.containers import Box
 from collidium.errors import InputError
+from collidium.kernels import tree
 from collidium.kernels.pairwise import coulomb_direct
 from collidium.state import FloatArray, Particles
+
+SumMethod = Literal["auto", "direct", "tree"]
+SUM_METHODS: tuple[SumMethod, ...] = ("auto", "direct", "tree")
+
+#: Charged particles from which ``method="auto"`` sums by tree: below it the direct sum is faster
+#: (measured with ``benchmarks/bench_core.py`` on 2 cores, where the two cost the same).
+TREE_CROSSOVER = 5000
+
+#: The tree's default opening angle.
+DEFAULT_THETA = tree.THETA
 
 
 @dataclass(frozen=True)
@@ -29,16 +41,25 @@ class Coulomb:
     max_acceleration : float or None
         The seed's limiter: accelerations are capped smoothly,
         ``a -> a / sqrt(1 + (|a| / a_max)^2)``. Not energy conserving (seed 4.2); None to disable.
+    method : {"auto", "direct", "tree"}
+        How the pair sum is done: "direct", every pair in a parallel numba kernel, O(N^2), exact;
+        "tree", a Barnes-Hut quadtree with order-4 multipoles, O(N log N) (`kernels/tree.py`);
+        "auto", the tree from `TREE_CROSSOVER` particles on in a walled box, else direct.
+    theta : float
+        The tree's opening angle (0 < theta < 1): smaller is more accurate and slower. The
+        default keeps the RMS relative force error below 1e-3 (see `kernels/tree.py`).
 
     Notes
     -----
-    Direct summation in a parallel numba kernel, O(N^2). In a periodic box the minimum image is
-    used (an approximation until Ewald summation exists).
+    In a periodic box the minimum image is used (an approximation until Ewald summation
+    exists); the tree cannot follow it, so a periodic box always sums directly.
     """
 
     k: float = 5.0
     softening: float = 0.0
     max_acceleration: float | None = None
+    method: SumMethod = "auto"
+    theta: float = DEFAULT_THETA
 
     def __post_init__(self) -> None:
         if not math.isfinite(self.k):
@@ -48,6 +69,26 @@ class Coulomb:
         cap = self.max_acceleration
         if cap is not None and (not math.isfinite(cap) or cap <= 0):
             raise InputError("forces.coulomb.max_acceleration", f"must be > 0, got {cap!r}")
+        if self.method not in SUM_METHODS:
+            raise InputError(
+                "forces.coulomb.method", f"must be one of {SUM_METHODS}, got {self.method!r}"
+            )
+        if not (isinstance(self.theta, int | float) and 0.0 < self.theta < 1.0):
+            raise InputError("forces.coulomb.theta", f"must be between 0 and 1, got {self.theta!r}")
+
+    def check_box(self, box: Box) -> None:
+        """Refuse the tree in a periodic box (it cannot follow the minimum image)."""
+        if box.periodic and self.method == "tree":
+            raise InputError(
+                "forces.coulomb.method",
+                "the tree cannot sum a periodic box (minimum image); use 'direct' or 'auto'",
+            )
+
+    def uses_tree(self, particles: Particles, box: Box) -> bool:
+        """Whether `compute` sums by tree for these particles in this box."""
+        if box.periodic or self.method == "direct":
+            return False
+        return self.method == "tree" or particles.n >= TREE_CROSSOVER
 
     def compute(
         self,
@@ -56,10 +97,23 @@ class Coulomb:
         force: FloatArray,
         energy: FloatArray,
         virial: FloatArray,
+        work: dict[str, np.ndarray] | None = None,
     ) -> None:
         """Write this force on each particle into ``force`` (N, 2), in N, and each particle's share
         of the pair energy into ``energy`` (N,) and of the pair virial ``sum r_ij . F_ij`` into
-        ``virial`` (N,), both in J (their sums are the totals)."""
+        ``virial`` (N,), both in J (their sums are the totals).
+
+        ``work`` holds the tree's buffers between calls (filled on first use; a fresh one is made
+        for this call if None)."""
+        if self.uses_tree(particles, box):
+            work = {} if work is None else work
+            if not work:
+                work.update(tree.tree_buffers(particles.n))
+            tree.coulomb_tree(
+                particles.position, particles.charge, self.k, self.softening**2, force, energy,
+                virial, work, theta=self.theta,
+            )  # fmt: skip
+            return
         coulomb_direct(
             particles.position, particles.charge, self.k, self.softening**2,
             box.width, box.height, box.periodic, force, energy, virial,
@@ -77,6 +131,10 @@ class Coulomb:
         out: dict[str, object] = {"type": "coulomb", "k": self.k, "softening": self.softening}
         if self.max_acceleration is not None:
             out["max_acceleration"] = self.max_acceleration
+        if self.method != "auto":
+            out["method"] = self.method
+        if self.theta != DEFAULT_THETA:
+            out["theta"] = self.theta
         return out
 
 
@@ -91,6 +149,7 @@ class ForceField:
 
     def __init__(self, forces: tuple[Coulomb, ...]) -> None:
         self.forces = tuple(forces)
+        self._work: list[dict[str, np.ndarray]] = [{} for _ in self.forces]  # tree buffers
         self._force = np.empty((0, 2))
         self._energy = np.empty(0)
         self._virial = np.empty(0)
@@ -123,8 +182,8 @@ class ForceField:
             self._acceleration = np.empty((n, 2))
         self._acceleration[...] = 0.0
         potential = virial = 0.0
-        for force in self.forces:
-            force.compute(particles, box, self._force, self._energy, self._virial)
+        for force, work in zip(self.forces, self._work, strict=True):
+            force.compute(particles, box, self._force, self._energy, self._virial, work)
             np.divide(self._force, particles.mass[:, None], out=self._force)  # now an acceleration
             force.limit(self._force)
             self._acceleration += self._force

@@ -60,7 +60,7 @@ from pydantic import (
 
 from collidium.containers import Box
 from collidium.errors import InputError
-from collidium.forces import Coulomb
+from collidium.forces import DEFAULT_THETA, Coulomb
 from collidium.initial import balanced_charges, random_positions, rhombus_rack, uniform_velocities
 from collidium.io.trajectory import GSDWriter
 from collidium.observers import (
@@ -158,10 +158,15 @@ class CoulombSpec(_Model):
     k: Finite = 5.0
     softening: NonNegative = 0.0
     max_acceleration: Positive | None = None
+    method: Literal["auto", "direct", "tree"] = "auto"
+    theta: Annotated[float, Field(gt=0.0, lt=1.0)] = DEFAULT_THETA
 
     def build(self) -> Coulomb:
         """The `Coulomb` force this describes."""
-        return Coulomb(k=self.k, softening=self.softening, max_acceleration=self.max_acceleration)
+        return Coulomb(
+            k=self.k, softening=self.softening, max_acceleration=self.max_acceleration,
+            method=self.method, theta=self.theta,
+        )  # fmt: skip
 
 
 ForceSpec = Annotated[CoulombSpec, Field(discriminator="type")]

@@ -179,7 +179,7 @@ class Simulation:
 
     @forces.setter
     def forces(self, forces: Sequence[Coulomb]) -> None:
-        _check_forces(forces)
+        _check_forces(forces, self.container)
         self._field = ForceField(tuple(forces))
 
     def run(
@@ -443,16 +443,17 @@ def _check_setup(
         raise InputError("container", f"must be a Box, got {type(container).__name__}")
     if not isinstance(particles, Particles):
         raise InputError("particles", f"must be Particles, got {type(particles).__name__}")
-    _check_forces(forces)
+    _check_forces(forces, container)
     _check_dt(dt)
     _check_mode(collisions)
     container.check_fits(particles.radius)
 
 
-def _check_forces(forces: Sequence[Coulomb]) -> None:
+def _check_forces(forces: Sequence[Coulomb], container: Box) -> None:
     for k, force in enumerate(forces):
         if not isinstance(force, Coulomb):
             raise InputError(f"forces.{k}", f"unknown force {type(force).__name__}")
+        force.check_box(container)
 
 
 def _check_mode(collisions: str) -> None:

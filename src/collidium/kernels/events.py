@@ -1,15 +1,27 @@
 """Event-driven drift of hard disks: exact free flight between exact elastic collisions.
 
-Design (Rapaport; Donev, Torquato & Stillinger):
+Design (Rapaport; Donev, Torquato & Stillinger; Bannerman's DynamO for the memory layout):
 
 - Each particle keeps one next event: a pair contact, a wall contact or a crossing into the next
-  cell of the grid. An indexed binary heap orders particles by that event time, ties by index.
-- Positions are lazy: ``position[i]`` is where particle i was at its own time stamp
-  ``stamp[i]``; at time t it is at ``position[i] + velocity[i] * (t - stamp[i])``.
+  cell of the grid. A 4-ary heap orders particles by that event time.
+- Positions are lazy: a particle's row holds where it was at its own time stamp; at time t it is
+  at ``x + v (t - stamp)``.
 - A pair event records the partner's collision count when it was predicted; if the partner has
   collided since, the event is stale and the particle is simply re-predicted.
 - Cells are at least one largest diameter wide, so a particle's possible partners are in the
-  9 cells around it; crossing into another cell re-predicts it against its new neighbours.
+  9 cells around it (found arithmetically, with the periodic wrap); crossing into another cell
+  re-predicts it against its new neighbours.
+
+Memory layout. At 1e5 particles and more the engine waits on memory, not arithmetic, so:
+
+- Particles live in *slots* of the engine's own order, sorted by cell and re-sorted every few
+  events per particle (`sort_slots`), so that neighbours sit close in memory. ``ident[k]`` is the
+  particle (its index in `collidium.state.Particles`) in slot k. Every tie between equal event
+  times is broken by ident, never by slot, so the outcome does not depend on the slot order.
+- Everything a prediction reads of a neighbour is one 64-byte row of ``body``:
+  ``x, y, vx, vy, stamp, radius, mass`` (m, m/s, s, m, kg).
+- An event is one int32 code: the partner's slot (>= 0), a wall (`WALL_CODES`) or a cell
+  crossing (`CELL_CODES`); indices are int32.
 
 All state lives in arrays owned by the caller (`collidium.collisions.ExactCollisions`), so the queue
 survives from one call to the next: with no forces, dt is only a reporting interval.
@@ -22,22 +34,37 @@ import math
 import numba
 import numpy as np
 
-from collidium.kernels.cells import fill_cells
+from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import elastic_response
 
-NO_EVENT = 0
-PAIR = 1
-WALL = 2
-CELL = 3
+#: Columns of the ``body`` rows; PAIR_TIME is the earliest pair contact found at the last
+#: prediction (s), kept to shorten predictions after cell crossings.
+X, Y, VX, VY, STAMP, RADIUS, MASS, PAIR_TIME = range(8)
+BODY_COLUMNS = 8  # one 64-byte row
+
+#: Columns of the ``event`` rows (int32): the next event's code, the partner's collision count
+#: when it was predicted (a later count makes the event stale), and the same two for the
+#: earliest pair contact found (`predict`).
+CODE, PARTNER_COUNT, CACHED, CACHED_COUNT = range(4)
+EVENT_COLUMNS = 4
+
+#: Event codes below 0: wall w (0 left, 1 right, 2 bottom, 3 top) is ``-1 - w``; a crossing into
+#: the neighbouring cell in direction d (0 -x, 1 +x, 2 -y, 3 +y) is ``-5 - d``.
+WALL_CODES = (-1, -4)
+CELL_CODES = (-5, -8)
+NO_EVENT = -9
 
 #: Index of each entry of the ``tally`` array (counts) and of the ``impulse`` array (sums).
 PAIR_COLLISIONS = 0  # tally: pair collisions; impulse: pair virial sum of r_ij . dp_i (kg m^2/s)
 WALL_HITS = 1  # 4 entries: left, right, bottom, top wall (tally: hits; impulse: kg m/s received)
 
-
 #: Relative size, against the particles' speeds, of an approach too slow to be anything but
 #: round-off (see `contact_delay`).
 CONTACT_SLACK = 1e-12
+
+#: Events per particle between two re-sorts of the slots by cell (sorting costs about as much as
+#: one event per particle; neighbours drift apart in memory over tens of events).
+SORT_INTERVAL = 16
 
 
 @numba.njit(cache=True, inline="always")
@@ -80,276 +107,398 @@ def contact_delay(
     return gap / (-b + math.sqrt(disc))
 
 
+# --- the event queue: a 4-ary heap of slots keyed by event time --------------------------------
+#
+# The heap compares times only (branch-free minimum of 4 children, several times faster than
+# comparing (time, ident) pairs); equal times are ordered by ident when the next event is taken
+# (`earliest`), so the order of events is still the total order (time, ident).
+
+
 @numba.njit(cache=True, inline="always")
-def _before(key_a: float, a: int, key_b: float, b: int) -> bool:
-    return key_a < key_b or (key_a == key_b and a < b)
-
-
-@numba.njit(cache=True)
-def _sift_up(slot: int, heap: np.ndarray, keys: np.ndarray, where: np.ndarray) -> int:
-    item = heap[slot]
-    key = keys[slot]
+def _sift_up(slot, key, item, keys, items, where) -> int:
+    """Move ``(key, item)`` up from ``slot`` to its place; return where it landed."""
     while slot > 0:
-        parent = (slot - 1) >> 1
-        if not _before(key, item, keys[parent], heap[parent]):
+        parent = (slot - 1) >> 2
+        above = keys[parent]
+        if above <= key:
             break
-        heap[slot] = heap[parent]
-        keys[slot] = keys[parent]
-        where[heap[slot]] = slot
+        keys[slot] = above
+        moved = items[parent]
+        items[slot] = moved
+        where[moved] = slot
         slot = parent
-    heap[slot] = item
     keys[slot] = key
+    items[slot] = item
     where[item] = slot
     return slot
 
 
-@numba.njit(cache=True)
-def _sift_down(slot: int, heap: np.ndarray, keys: np.ndarray, where: np.ndarray) -> None:
-    n = heap.shape[0]
-    item = heap[slot]
-    key = keys[slot]
+@numba.njit(cache=True, inline="always")
+def _sift_down(slot, key, item, keys, items, where) -> None:
+    """Move ``(key, item)`` down from ``slot`` to its place."""
+    n = keys.shape[0]
     while True:
-        child = 2 * slot + 1
-        if child >= n:
+        first = 4 * slot + 1
+        if first >= n:
             break
-        if child + 1 < n and _before(keys[child + 1], heap[child + 1], keys[child], heap[child]):
-            child += 1
-        if not _before(keys[child], heap[child], key, item):
+        child = first
+        least = keys[first]
+        for c in range(first + 1, min(first + 4, n)):
+            if keys[c] < least:
+                child = c
+                least = keys[c]
+        if key <= least:
             break
-        heap[slot] = heap[child]
-        keys[slot] = keys[child]
-        where[heap[slot]] = slot
+        keys[slot] = least
+        moved = items[child]
+        items[slot] = moved
+        where[moved] = slot
         slot = child
-    heap[slot] = item
     keys[slot] = key
+    items[slot] = item
     where[item] = slot
 
 
-@numba.njit(cache=True)
-def heap_update(i: int, key: float, heap: np.ndarray, keys: np.ndarray, where: np.ndarray) -> None:
-    """Give particle i the event time ``key`` and restore heap order (O(log N)).
-
-    The heap keeps each key next to its particle index (``keys[slot]``) so that sifting reads
-    contiguous memory instead of chasing ``event_time[heap[slot]]``.
-    """
-    slot = where[i]
-    keys[slot] = key
-    if _sift_up(slot, heap, keys, where) == slot:
-        _sift_down(slot, heap, keys, where)
+@numba.njit(cache=True, inline="always")
+def heap_update(k, key, keys, items, where) -> None:
+    """Give slot k the event time ``key`` (s) and restore heap order (O(log N))."""
+    slot = where[k]
+    if _sift_up(slot, key, k, keys, items, where) == slot:
+        _sift_down(slot, key, k, keys, items, where)
 
 
 @numba.njit(cache=True)
-def heap_build(event_time: np.ndarray, heap: np.ndarray, keys: np.ndarray, where: np.ndarray):
-    """Heap of all particles ordered by ``event_time`` then index (O(N))."""
-    n = heap.shape[0]
-    for i in range(n):
-        heap[i] = i
-        keys[i] = event_time[i]
-        where[i] = i
-    for slot in range(n // 2 - 1, -1, -1):
-        _sift_down(slot, heap, keys, where)
+def _earliest_tied(keys, items, ident) -> int:
+    """Among the entries whose time equals the root's, the slot with the lowest ident (a
+    depth-first search through the children of equal time: heap order puts all of them there)."""
+    best = items[0]
+    stack = [0]
+    while stack:
+        s = stack.pop()
+        if ident[items[s]] < ident[best]:
+            best = items[s]
+        for c in range(4 * s + 1, min(4 * s + 5, keys.shape[0])):
+            if keys[c] == keys[0]:
+                stack.append(c)
+    return best
+
+
+@numba.njit(cache=True, inline="always")
+def earliest(keys, items, ident) -> int:
+    """The slot whose event comes first in the order (time, ident)."""
+    for c in range(1, min(5, keys.shape[0])):
+        if keys[c] == keys[0]:
+            return _earliest_tied(keys, items, ident)
+    return items[0]
 
 
 @numba.njit(cache=True)
-def predict(
-    i: int,
-    now: float,
-    position: np.ndarray,
-    velocity: np.ndarray,
-    stamp: np.ndarray,
-    radius: np.ndarray,
-    geometry: np.ndarray,
-    grid: np.ndarray,
-    cell_of: np.ndarray,
-    head: np.ndarray,
-    next_: np.ndarray,
-    cells: np.ndarray,
-    shifts: np.ndarray,
-    collisions: np.ndarray,
-    event_time: np.ndarray,
-    event_kind: np.ndarray,
-    event_other: np.ndarray,
-    event_stamp: np.ndarray,
-) -> None:
-    """Find particle i's next event after time ``now`` and store it (not in the heap yet).
+def _heap_build(keys, items, where) -> None:
+    """Order a heap whose ``keys[s]`` belong to slot ``s`` (O(N))."""
+    n = keys.shape[0]
+    for s in range(n):
+        items[s] = s
+        where[s] = s
+    for s in range((n - 2) // 4, -1, -1):
+        _sift_down(s, keys[s], items[s], keys, items, where)
 
-    ``geometry`` is ``[half_width, half_height, cell_width, cell_height]`` in m; ``grid`` is
-    ``[ncx, ncy, periodic]``. Ties go to the first found in a fixed order (walls, cells, then the
-    partner with the lowest index), so the outcome does not depend on the order of cell lists.
 
+# --- predictions --------------------------------------------------------------------------------
+
+
+@numba.njit(cache=True, inline="always")
+def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid):
+    """Earliest wall contact or cell crossing of a disk at (x, y) in cell c: ``(delay in s,
+    code)``. Ties go to the first found: walls before cells, x before y."""
+    hw = geometry[0]
+    hh = geometry[1]
+    ncx = grid[0]
+    periodic = grid[2] != 0
+    best = math.inf
+    code = NO_EVENT
+    if not periodic:  # walls: -1 - (2 d + upper)
+        for d in range(2):
+            v = vx if d == 0 else vy
+            pos = x if d == 0 else y
+            half = hw if d == 0 else hh
+            if v > 0.0:
+                delay = max((half - r - pos) / v, 0.0)
+                if delay < best:
+                    best, code = delay, -2 - 2 * d
+            elif v < 0.0:
+                delay = max((-half + r - pos) / v, 0.0)
+                if delay < best:
+                    best, code = delay, -1 - 2 * d
+    for d in range(2):  # cell crossings: -5 - (2 d + upper)
+        v = vx if d == 0 else vy
+        pos = x if d == 0 else y
+        half = hw if d == 0 else hh
+        size = geometry[2 + d]
+        at = c % ncx if d == 0 else c // ncx
+        cells = grid[d]
+        if v > 0.0 and (periodic or at < cells - 1):
+            delay = max((-half + (at + 1) * size - pos) / v, 0.0)
+            if delay < best:
+                best, code = delay, -6 - 2 * d
+        elif v < 0.0 and (periodic or at > 0):
+            delay = max((-half + at * size - pos) / v, 0.0)
+            if delay < best:
+                best, code = delay, -5 - 2 * d
+    return best, code
+
+
+@numba.njit(cache=True, inline="always")
+def _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry, grid, cell_of,
+                head, next_):  # fmt: skip
+    """Earliest contact of slot k, at (x, y) at time ``now``, with the disks in a block of cells
+    around its own: ``rows`` and ``columns`` are ``(first, last)`` offsets from k's cell.
+
+    Returns ``(delay in s, partner slot)``, ``(inf, -1)`` if none; ties go to the lowest ident.
     """
     hw = geometry[0]
     hh = geometry[1]
     ncx = grid[0]
     ncy = grid[1]
     periodic = grid[2] != 0
-    lag = now - stamp[i]
-    xi = position[i, 0] + velocity[i, 0] * lag
-    yi = position[i, 1] + velocity[i, 1] * lag
-    vxi = velocity[i, 0]
-    vyi = velocity[i, 1]
-    ri = radius[i]
+    c = cell_of[k]
+    cx = c % ncx
+    cy = c // ncx
+    speed = abs(vx) + abs(vy)
     best = math.inf
-    kind = NO_EVENT
-    other = -1
-
-    if not periodic:
-        for d in range(2):
-            v = velocity[i, d]
-            x = xi if d == 0 else yi
-            half = hw if d == 0 else hh
-            if v > 0.0:
-                delay = max((half - ri - x) / v, 0.0)
-                if delay < best:
-                    best, kind, other = delay, WALL, 2 * d + 1
-            elif v < 0.0:
-                delay = max((-half + ri - x) / v, 0.0)
-                if delay < best:
-                    best, kind, other = delay, WALL, 2 * d
-
-    c = cell_of[i]
-    if c >= 0:
-        cxy = (c % ncx, c // ncx)
-        counts = (ncx, ncy)
-        for d in range(2):
-            v = velocity[i, d]
-            x = xi if d == 0 else yi
-            half = hw if d == 0 else hh
-            size = geometry[2 + d]
-            k = cxy[d]
-            if v > 0.0 and (periodic or k < counts[d] - 1):
-                delay = max((-half + (k + 1) * size - x) / v, 0.0)
-                if delay < best:
-                    best, kind, other = delay, CELL, 2 * d + 1
-            elif v < 0.0 and (periodic or k > 0):
-                delay = max((-half + k * size - x) / v, 0.0)
-                if delay < best:
-                    best, kind, other = delay, CELL, 2 * d
-
-        if ri > 0.0:
-            speed_i = abs(vxi) + abs(vyi)
-            width = 2.0 * hw
-            height = 2.0 * hh
-            for q in range(9):
-                cell = cells[c, q]
-                if cell < 0:
-                    continue
-                ox = shifts[c, q, 0] * width
-                oy = shifts[c, q, 1] * height
-                j = head[cell]
-                while j >= 0:
-                    if j != i and radius[j] > 0.0:
-                        lag_j = now - stamp[j]
-                        dx = position[j, 0] + velocity[j, 0] * lag_j + ox - xi
-                        dy = position[j, 1] + velocity[j, 1] * lag_j + oy - yi
-                        sigma = ri + radius[j]
-                        speeds = speed_i + abs(velocity[j, 0]) + abs(velocity[j, 1])
-                        delay = contact_delay(
-                            dx, dy, velocity[j, 0] - vxi, velocity[j, 1] - vyi, sigma,
-                            CONTACT_SLACK * sigma * speeds,
-                        )  # fmt: skip
-                        if delay < best or (delay == best and kind == PAIR and j < other):
-                            best, kind, other = delay, PAIR, j
-                    j = next_[j]
-
-    event_time[i] = now + best
-    event_kind[i] = kind
-    event_other[i] = other
-    event_stamp[i] = collisions[other] if kind == PAIR else 0
+    best_slot = -1
+    best_ident = -1
+    for oy in range(rows[0], rows[1] + 1):
+        for ox in range(columns[0], columns[1] + 1):
+            cell, sx, sy = neighbour_cell(cx, cy, ox, oy, ncx, ncy, periodic, 2.0 * hw, 2.0 * hh)
+            if cell < 0:
+                continue
+            j = head[cell]
+            while j >= 0:
+                rj = body[j, RADIUS]
+                if j != k and rj > 0.0:
+                    lag_j = now - body[j, STAMP]
+                    vjx = body[j, VX]
+                    vjy = body[j, VY]
+                    dx = body[j, X] + vjx * lag_j + sx - x
+                    dy = body[j, Y] + vjy * lag_j + sy - y
+                    sigma = r + rj
+                    slack = CONTACT_SLACK * sigma * (speed + abs(vjx) + abs(vjy))
+                    delay = contact_delay(dx, dy, vjx - vx, vjy - vy, sigma, slack)
+                    if delay < best or (delay == best and best_slot >= 0 and ident[j] < best_ident):
+                        best, best_slot, best_ident = delay, j, ident[j]
+                j = next_[j]
+    return best, best_slot
 
 
 @numba.njit(cache=True, inline="always")
-def _advance(i: int, t: float, position: np.ndarray, velocity: np.ndarray, stamp: np.ndarray):
-    lag = t - stamp[i]
-    position[i, 0] += velocity[i, 0] * lag
-    position[i, 1] += velocity[i, 1] * lag
-    stamp[i] = t
+def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, count, event):
+    """Find slot k's next event after time ``now`` (s), store it, return its time (s).
+
+    The earliest pair contact found is kept too (``body[k, PAIR_TIME]``, ``event[k, CACHED]``):
+    after a cell crossing in direction ``crossed`` (0 -x, 1 +x, 2 -y, 3 +y; -1 for none) only the
+    3 cells newly in reach are searched and compared with it, if its partner has not collided
+    since. That is exact: k's velocity did not change, the neighbours that did not change cannot
+    come earlier than the kept contact, and any neighbour that changed or arrived since has
+    predicted against k itself.
+
+    ``geometry`` is ``[half_width, half_height, cell_width, cell_height]`` in m; ``grid`` is
+    ``[ncx, ncy, periodic]``. Ties go to the first found in a fixed order (walls, cells, then the
+    partner with the lowest ident), so the outcome does not depend on the slot order.
+    """
+    lag = now - body[k, STAMP]
+    vx = body[k, VX]
+    vy = body[k, VY]
+    x = body[k, X] + vx * lag
+    y = body[k, Y] + vy * lag
+    r = body[k, RADIUS]
+    delay, code = _walls_and_cells(x, y, vx, vy, r, cell_of[k], geometry, grid)
+    when = now + delay
+    pair_time = math.inf
+    pair = -1
+    if r > 0.0:
+        rows = (-1, 1)
+        columns = (-1, 1)
+        kept = event[k, CACHED]
+        # The kept contact must still be valid: if its partner collided since, the next
+        # earliest could be anywhere. In a grid under 3 cells wide, periodic neighbours repeat
+        # under several shifts.
+        partial = (
+            crossed >= 0
+            and (kept < 0 or count[kept] == event[k, CACHED_COUNT])
+            and grid[0] >= 3
+            and grid[1] >= 3
+        )
+        if partial:
+            edge = 1 if crossed % 2 == 1 else -1
+            if crossed < 2:
+                columns = (edge, edge)
+            else:
+                rows = (edge, edge)
+        found, pair = _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry,
+                                  grid, cell_of, head, next_)  # fmt: skip
+        pair_time = now + found
+        if partial and kept >= 0:
+            kept_time = body[k, PAIR_TIME]
+            if (
+                pair < 0
+                or kept_time < pair_time
+                or (kept_time == pair_time and ident[kept] < ident[pair])
+            ):
+                pair_time, pair = kept_time, kept
+        if pair >= 0 and pair_time < when:
+            when, code = pair_time, pair
+    body[k, PAIR_TIME] = pair_time
+    event[k, CACHED] = pair
+    event[k, CACHED_COUNT] = count[pair] if pair >= 0 else 0
+    event[k, CODE] = code
+    event[k, PARTNER_COUNT] = count[code] if code >= 0 else 0
+    return when
+
+
+# --- cells and slots ----------------------------------------------------------------------------
 
 
 @numba.njit(cache=True)
-def _move_to_cell(i: int, new: int, cell_of, head, next_, prev) -> None:
-    old = cell_of[i]
-    if prev[i] >= 0:
-        next_[prev[i]] = next_[i]
+def _link_cells(cell_of, head, next_, prev) -> None:
+    """Rebuild the per-cell doubly linked lists from ``cell_of``, each in increasing slot order."""
+    head[:] = -1
+    for k in range(cell_of.shape[0] - 1, -1, -1):
+        c = cell_of[k]
+        first = head[c]
+        next_[k] = first
+        prev[k] = -1
+        if first >= 0:
+            prev[first] = k
+        head[c] = k
+
+
+@numba.njit(cache=True, inline="always")
+def _move_to_cell(k, new, cell_of, head, next_, prev) -> None:
+    old = cell_of[k]
+    if prev[k] >= 0:
+        next_[prev[k]] = next_[k]
     else:
-        head[old] = next_[i]
-    if next_[i] >= 0:
-        prev[next_[i]] = prev[i]
+        head[old] = next_[k]
+    if next_[k] >= 0:
+        prev[next_[k]] = prev[k]
     first = head[new]
-    next_[i] = first
-    prev[i] = -1
+    next_[k] = first
+    prev[k] = -1
     if first >= 0:
-        prev[first] = i
-    head[new] = i
-    cell_of[i] = new
+        prev[first] = k
+    head[new] = k
+    cell_of[k] = new
 
 
-@numba.njit(cache=True)
-def _cross_cell(i, direction, position, image, geometry, grid, cell_of, head, next_, prev):
-    """Move particle i into the neighbouring cell; wrap it at a periodic edge."""
+@numba.njit(cache=True, inline="always")
+def _cross_cell(k, direction, body, ident, image, geometry, grid, cell_of, head, next_, prev):
+    """Move slot k into the neighbouring cell; wrap it at a periodic edge."""
     ncx = grid[0]
-    ncy = grid[1]
     d = direction // 2
     step = 1 if direction % 2 == 1 else -1
-    c = cell_of[i]
-    k = (c % ncx, c // ncx)[d]
-    count = (ncx, ncy)[d]
-    k += step
-    if k == count or k < 0:  # periodic edge
-        k %= count
-        span = 2.0 * geometry[d]
-        position[i, d] -= step * span
-        image[i, d] += step
-    cx = k if d == 0 else c % ncx
-    cy = k if d == 1 else c // ncx
-    _move_to_cell(i, cx + ncx * cy, cell_of, head, next_, prev)
+    c = cell_of[k]
+    at = (c % ncx if d == 0 else c // ncx) + step
+    cells = grid[d]
+    if at == cells or at < 0:  # periodic edge
+        at %= cells
+        body[k, d] -= step * 2.0 * geometry[d]
+        image[ident[k], d] += step
+    cx = at if d == 0 else c % ncx
+    cy = at if d == 1 else c // ncx
+    _move_to_cell(k, cx + ncx * cy, cell_of, head, next_, prev)
+
+
+@numba.njit(cache=True, inline="always")
+def _permute(array, order, scratch) -> None:
+    """``array[new] = array[order[new]]`` for an int32 array, through a float64 scratch (exact)."""
+    for new in range(array.shape[0]):
+        scratch[new] = array[order[new]]
+    for new in range(array.shape[0]):
+        array[new] = np.int32(scratch[new])
 
 
 @numba.njit(cache=True)
-def rebuild(
-    now: float,
-    position: np.ndarray,
-    velocity: np.ndarray,
-    stamp: np.ndarray,
-    radius: np.ndarray,
-    geometry: np.ndarray,
-    grid: np.ndarray,
-    cell_of: np.ndarray,
-    head: np.ndarray,
-    next_: np.ndarray,
-    prev: np.ndarray,
-    cells: np.ndarray,
-    shifts: np.ndarray,
-    collisions: np.ndarray,
-    event_time: np.ndarray,
-    event_kind: np.ndarray,
-    event_other: np.ndarray,
-    event_stamp: np.ndarray,
-    heap: np.ndarray,
-    heap_keys: np.ndarray,
-    heap_where: np.ndarray,
-) -> None:
-    """Start a fresh queue at time ``now`` from synchronised positions (all stamps = now)."""
-    stamp[:] = now
-    fill_cells(
-        position, radius, geometry[0], geometry[1], grid[0], grid[1], cell_of, head, next_, prev
-    )
-    for i in range(position.shape[0]):
-        predict(
-            i, now, position, velocity, stamp, radius, geometry, grid, cell_of, head, next_,
-            cells, shifts, collisions, event_time, event_kind, event_other, event_stamp,
-        )  # fmt: skip
-    heap_build(event_time, heap, heap_keys, heap_where)
+def sort_slots(body, ident, cell_of, count, event, head, next_, prev, items, where, order,
+               scratch) -> None:  # fmt: skip
+    """Renumber the slots in cell order (a counting sort), keeping every reference consistent.
+
+    ``order`` (N,) int32 and ``scratch`` (N,) float64 are work arrays; ``head`` doubles as the
+    counting array and ``prev`` as the inverse permutation before both are rebuilt.
+    """
+    n = body.shape[0]
+    head[:] = 0
+    for k in range(n):
+        head[cell_of[k]] += 1
+    start = 0
+    for c in range(head.shape[0]):
+        size = head[c]
+        head[c] = start
+        start += size
+    for k in range(n):  # stable: slots keep their relative order within a cell
+        c = cell_of[k]
+        order[head[c]] = k
+        head[c] += 1
+    inverse = prev
+    for new in range(n):
+        inverse[order[new]] = new
+    for column in range(BODY_COLUMNS):
+        for new in range(n):
+            scratch[new] = body[order[new], column]
+        body[:, column] = scratch
+    for array in (ident, cell_of, count):
+        _permute(array, order, scratch)
+    for column in range(EVENT_COLUMNS):
+        slots = column in (CODE, CACHED)
+        for new in range(n):
+            value = event[order[new], column]
+            scratch[new] = inverse[value] if slots and value >= 0 else value
+        for new in range(n):
+            event[new, column] = np.int32(scratch[new])
+    for s in range(n):
+        items[s] = inverse[items[s]]
+        where[items[s]] = s
+    _link_cells(cell_of, head, next_, prev)
+
+
+@numba.njit(cache=True)
+def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, prev, count, event, keys,
+            items, where, order, scratch) -> None:  # fmt: skip
+    """Start a fresh queue at time ``now`` (s) from positions synchronised at ``now``.
+
+    ``body``'s positions, velocities, radii and masses and ``ident`` are filled by the caller (see
+    `load`); this sets the stamps, sorts the slots by cell and predicts every event.
+    """
+    n = body.shape[0]
+    hw = geometry[0]
+    hh = geometry[1]
+    ncx = grid[0]
+    for k in range(n):
+        body[k, STAMP] = now
+        cell_of[k] = cell_index(body[k, X], hw, geometry[2], ncx) + ncx * cell_index(
+            body[k, Y], hh, geometry[3], grid[1]
+        )
+        count[k] = 0
+        event[k, CODE] = NO_EVENT
+        event[k, PARTNER_COUNT] = 0
+        event[k, CACHED] = -1
+        event[k, CACHED_COUNT] = 0
+        items[k] = k
+    sort_slots(body, ident, cell_of, count, event, head, next_, prev, items, where, order,
+               scratch)  # fmt: skip
+    for k in range(n):
+        keys[k] = predict(k, now, -1, body, ident, geometry, grid, cell_of, head, next_, count,
+                          event)  # fmt: skip
+    _heap_build(keys, items, where)
+
+
+# --- the drift ----------------------------------------------------------------------------------
 
 
 @numba.njit(cache=True)
 def run_events(
     until: float,
-    position: np.ndarray,
-    velocity: np.ndarray,
-    stamp: np.ndarray,
-    mass: np.ndarray,
-    radius: np.ndarray,
+    body: np.ndarray,
+    ident: np.ndarray,
     image: np.ndarray,
     geometry: np.ndarray,
     grid: np.ndarray,
@@ -357,20 +506,18 @@ def run_events(
     head: np.ndarray,
     next_: np.ndarray,
     prev: np.ndarray,
-    cells: np.ndarray,
-    shifts: np.ndarray,
-    collisions: np.ndarray,
-    event_time: np.ndarray,
-    event_kind: np.ndarray,
-    event_other: np.ndarray,
-    event_stamp: np.ndarray,
-    heap: np.ndarray,
-    heap_keys: np.ndarray,
-    heap_where: np.ndarray,
+    count: np.ndarray,
+    event: np.ndarray,
+    keys: np.ndarray,
+    items: np.ndarray,
+    where: np.ndarray,
+    order: np.ndarray,
+    scratch: np.ndarray,
     tally: np.ndarray,
     impulse: np.ndarray,
     acceleration: np.ndarray,
     midpoint: float,
+    sort_every: int,
 ) -> int:
     """Process every event up to time ``until`` (inclusive) in time order.
 
@@ -378,14 +525,19 @@ def run_events(
     ----------
     until : float
         End of the drift, in s (absolute simulation time).
+    image : ndarray of int64, shape (N, 2)
+        Periodic image counters, by particle (not slot); updated at wraps.
     tally : ndarray of int64, shape (5,)
         Incremented: pair collisions, then hits on the left, right, bottom, top wall.
     impulse : ndarray of float64, shape (5,)
         Incremented: the collision virial ``sum r_ij . dp_i`` (kg m^2/s, ``r_ij = x_i - x_j`` at
         contact, ``dp_i`` the impulse on i), then the momentum given to each wall (kg m/s).
     acceleration : ndarray, shape (N, 2) or (0, 2)
-        With forces, the acceleration of the step's half kicks (m/s^2), and ``midpoint`` the
-        middle of the step (s): see `_pair_response`. Empty without forces.
+        With forces, the acceleration of the step's half kicks (m/s^2), by particle, and
+        ``midpoint`` the middle of the step (s): see `_pair_response`. Empty without forces.
+    sort_every : int
+        Events between two re-sorts of the slots (`sort_slots`); the outcome does not depend on
+        it, only the speed.
     (other arrays)
         Engine state as built by `rebuild`; updated in place.
 
@@ -397,83 +549,105 @@ def run_events(
         contacts allow, which only a runaway state (huge or infinite velocities) produces.
     """
     processed = 0
-    n = position.shape[0]
+    n = body.shape[0]
     if n == 0:
         return 0
     instant = -math.inf
     at_instant = 0
+    since_sort = 0
     while True:
-        i = heap[0]
-        t = heap_keys[0]
+        if since_sort >= sort_every:
+            sort_slots(body, ident, cell_of, count, event, head, next_, prev, items, where,
+                       order, scratch)  # fmt: skip
+            since_sort = 0
+        t = keys[0]
         if t > until:
             break
+        k = earliest(keys, items, ident)
         processed += 1
+        since_sort += 1
         if t > instant:
             instant = t
             at_instant = 0
         at_instant += 1
         if at_instant > 100 * n + 10_000:
-            return -1 - i
-        kind = event_kind[i]
-        if kind == PAIR:
-            j = event_other[i]
-            if collisions[j] == event_stamp[i]:
-                _advance(i, t, position, velocity, stamp)
-                _advance(j, t, position, velocity, stamp)
-                # Contact normal x_i - x_j; in contact the pair is at most half a side apart,
-                # so the minimum image is the one that touches.
-                nx = position[i, 0] - position[j, 0]
-                ny = position[i, 1] - position[j, 1]
-                if grid[2] != 0:
-                    nx -= 2.0 * geometry[0] * round(nx / (2.0 * geometry[0]))
-                    ny -= 2.0 * geometry[1] * round(ny / (2.0 * geometry[1]))
-                v1x, v1y, v2x, v2y = _pair_response(
-                    i, j, nx, ny, midpoint - t, mass, velocity, acceleration
-                )
-                impulse[PAIR_COLLISIONS] += mass[i] * (
-                    nx * (v1x - velocity[i, 0]) + ny * (v1y - velocity[i, 1])
-                )
-                velocity[i, 0] = v1x
-                velocity[i, 1] = v1y
-                velocity[j, 0] = v2x
-                velocity[j, 1] = v2y
-                collisions[i] += 1
-                collisions[j] += 1
-                tally[PAIR_COLLISIONS] += 1
-                predict(
-                    j, t, position, velocity, stamp, radius, geometry, grid, cell_of, head,
-                    next_, cells, shifts, collisions, event_time, event_kind,
-                    event_other, event_stamp,
-                )  # fmt: skip
-                heap_update(j, event_time[j], heap, heap_keys, heap_where)
-        elif kind == WALL:
-            _advance(i, t, position, velocity, stamp)
-            wall = event_other[i]
-            d = wall // 2
-            half = geometry[d]
-            # Snap to the contact point so round-off never leaves the disk past the wall.
-            position[i, d] = (half - radius[i]) if wall % 2 == 1 else (radius[i] - half)
-            before = velocity[i, d]
-            velocity[i, d] = _wall_response(before, wall % 2 == 1, i, d, midpoint - t, acceleration)
-            impulse[WALL_HITS + wall] += mass[i] * abs(velocity[i, d] - before)
-            collisions[i] += 1
-            tally[WALL_HITS + wall] += 1
-        elif kind == CELL:
-            _advance(i, t, position, velocity, stamp)
-            _cross_cell(
-                i, event_other[i], position, image, geometry, grid, cell_of, head, next_, prev
-            )
-        predict(
-            i, t, position, velocity, stamp, radius, geometry, grid, cell_of, head, next_,
-            cells, shifts, collisions, event_time, event_kind, event_other, event_stamp,
-        )  # fmt: skip
-        heap_update(i, event_time[i], heap, heap_keys, heap_where)
+            return -1 - ident[k]
+        code = event[k, CODE]
+        crossed = -1
+        if code >= 0:
+            j = code
+            if count[j] == event[k, PARTNER_COUNT]:
+                _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
+                         midpoint)  # fmt: skip
+                count[k] += 1
+                count[j] += 1
+                t_j = predict(j, t, -1, body, ident, geometry, grid, cell_of, head, next_,
+                              count, event)  # fmt: skip
+                heap_update(j, t_j, keys, items, where)
+        elif code >= WALL_CODES[1]:
+            _bounce(k, -1 - code, t, body, ident, geometry, tally, impulse, acceleration, midpoint)
+            count[k] += 1
+        elif code >= CELL_CODES[1]:
+            crossed = -5 - code
+            _advance(k, t, body)
+            _cross_cell(k, crossed, body, ident, image, geometry, grid, cell_of, head, next_,
+                        prev)  # fmt: skip
+        t_k = predict(k, t, crossed, body, ident, geometry, grid, cell_of, head, next_, count,
+                      event)  # fmt: skip
+        heap_update(k, t_k, keys, items, where)
     return processed
 
 
 @numba.njit(cache=True, inline="always")
-def _pair_response(i, j, nx, ny, lead, mass, velocity, acceleration):
-    """Velocities of i and j after their collision, with the kick timing corrected.
+def _advance(k: int, t: float, body: np.ndarray) -> None:
+    lag = t - body[k, STAMP]
+    body[k, X] += body[k, VX] * lag
+    body[k, Y] += body[k, VY] * lag
+    body[k, STAMP] = t
+
+
+@numba.njit(cache=True, inline="always")
+def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration, midpoint):
+    """Elastic collision of slots k and j at time t (s)."""
+    _advance(k, t, body)
+    _advance(j, t, body)
+    # Contact normal x_k - x_j; in contact the pair is at most half a side apart, so the
+    # minimum image is the one that touches.
+    nx = body[k, X] - body[j, X]
+    ny = body[k, Y] - body[j, Y]
+    if grid[2] != 0:
+        nx -= 2.0 * geometry[0] * round(nx / (2.0 * geometry[0]))
+        ny -= 2.0 * geometry[1] * round(ny / (2.0 * geometry[1]))
+    v1x, v1y, v2x, v2y = _pair_response(k, j, nx, ny, midpoint - t, body, ident, acceleration)
+    impulse[PAIR_COLLISIONS] += body[k, MASS] * (
+        nx * (v1x - body[k, VX]) + ny * (v1y - body[k, VY])
+    )
+    body[k, VX] = v1x
+    body[k, VY] = v1y
+    body[j, VX] = v2x
+    body[j, VY] = v2y
+    tally[PAIR_COLLISIONS] += 1
+
+
+@numba.njit(cache=True, inline="always")
+def _bounce(k, wall, t, body, ident, geometry, tally, impulse, acceleration, midpoint):
+    """Slot k hits wall ``wall`` (0 left, 1 right, 2 bottom, 3 top) at time t (s)."""
+    _advance(k, t, body)
+    d = wall // 2
+    upper = wall % 2 == 1
+    half = geometry[d]
+    # Snap to the contact point so round-off never leaves the disk past the wall.
+    body[k, X + d] = (half - body[k, RADIUS]) if upper else (body[k, RADIUS] - half)
+    before = body[k, VX + d]
+    after = _wall_response(before, upper, ident[k], d, midpoint - t, acceleration)
+    body[k, VX + d] = after
+    impulse[WALL_HITS + wall] += body[k, MASS] * abs(after - before)
+    tally[WALL_HITS + wall] += 1
+
+
+@numba.njit(cache=True, inline="always")
+def _pair_response(k, j, nx, ny, lead, body, ident, acceleration):
+    """Velocities of k and j after their collision, with the kick timing corrected.
 
     In a kick-drift-kick step each particle got ``a dt/2`` before the drift, although, at a
     collision at time tau into the step, only ``a tau`` of that impulse was physically received
@@ -483,24 +657,27 @@ def _pair_response(i, j, nx, ny, lead, mass, velocity, acceleration):
     error per collision becomes O(dt^2). If that would leave the pair still approaching (a slow
     contact under strong attraction), the plain response ``C(v)`` is used.
     """
-    v1x, v1y = velocity[i, 0], velocity[i, 1]
-    v2x, v2y = velocity[j, 0], velocity[j, 1]
+    m1 = body[k, MASS]
+    m2 = body[j, MASS]
+    v1x, v1y = body[k, VX], body[k, VY]
+    v2x, v2y = body[j, VX], body[j, VY]
     if acceleration.shape[0] > 0:
-        d1x, d1y = lead * acceleration[i, 0], lead * acceleration[i, 1]
-        d2x, d2y = lead * acceleration[j, 0], lead * acceleration[j, 1]
+        a, b = ident[k], ident[j]
+        d1x, d1y = lead * acceleration[a, 0], lead * acceleration[a, 1]
+        d2x, d2y = lead * acceleration[b, 0], lead * acceleration[b, 1]
         w1x, w1y, w2x, w2y = elastic_response(
-            mass[i], mass[j], nx, ny, v1x - d1x, v1y - d1y, v2x - d2x, v2y - d2y
+            m1, m2, nx, ny, v1x - d1x, v1y - d1y, v2x - d2x, v2y - d2y
         )
         w1x, w1y, w2x, w2y = w1x + d1x, w1y + d1y, w2x + d2x, w2y + d2y
         if (w1x - w2x) * nx + (w1y - w2y) * ny > 0.0:
             return w1x, w1y, w2x, w2y
-    return elastic_response(mass[i], mass[j], nx, ny, v1x, v1y, v2x, v2y)
+    return elastic_response(m1, m2, nx, ny, v1x, v1y, v2x, v2y)
 
 
 @numba.njit(cache=True, inline="always")
 def _wall_response(v, upper, i, d, lead, acceleration):
     """Normal velocity after a wall bounce, with the same kick-timing correction as pairs:
-    ``v' = -(v - delta) + delta``, kept only if it moves away from the wall."""
+    ``v' = -(v - delta) + delta``, kept only if it moves away from the wall (i: the particle)."""
     if acceleration.shape[0] > 0:
         corrected = -v + 2.0 * lead * acceleration[i, d]
         if (corrected < 0.0) if upper else (corrected > 0.0):
@@ -508,13 +685,59 @@ def _wall_response(v, upper, i, d, lead, acceleration):
     return -v
 
 
+# --- between the engine and the particles -------------------------------------------------------
+
+
 @numba.njit(cache=True)
-def synchronise(
-    now: float, position: np.ndarray, velocity: np.ndarray, stamp: np.ndarray, out: np.ndarray
-) -> None:
-    """Write every particle's position at time ``now`` into ``out`` (shape (N, 2)), lazily kept
-    state untouched so the queue stays valid."""
+def load(position, velocity, radius, mass, body, ident) -> None:
+    """Fill ``body`` (N, 8) and ``ident`` (N,) from the particles, in particle order.
+
+    Parameters
+    ----------
+    position, velocity : ndarray, shape (N, 2)
+        In m and m/s.
+    radius, mass : ndarray, shape (N,)
+        In m and kg.
+    """
     for i in range(position.shape[0]):
-        lag = now - stamp[i]
-        out[i, 0] = position[i, 0] + velocity[i, 0] * lag
-        out[i, 1] = position[i, 1] + velocity[i, 1] * lag
+        body[i, X] = position[i, 0]
+        body[i, Y] = position[i, 1]
+        body[i, VX] = velocity[i, 0]
+        body[i, VY] = velocity[i, 1]
+        body[i, RADIUS] = radius[i]
+        body[i, MASS] = mass[i]
+        body[i, MASS + 1] = 0.0
+        ident[i] = i
+
+
+@numba.njit(cache=True)
+def synchronise(now, body, ident, position, velocity) -> None:
+    """Write every particle's position at time ``now`` (s) and velocity into ``position`` and
+    ``velocity`` (N, 2), by particle; the lazily kept state is untouched so the queue stays
+    valid."""
+    for k in range(body.shape[0]):
+        i = ident[k]
+        lag = now - body[k, STAMP]
+        position[i, 0] = body[k, X] + body[k, VX] * lag
+        position[i, 1] = body[k, Y] + body[k, VY] * lag
+        velocity[i, 0] = body[k, VX]
+        velocity[i, 1] = body[k, VY]
+
+
+@numba.njit(cache=True)
+def matches(now, body, ident, position, velocity, radius, mass) -> bool:
+    """True if the particles are exactly what `synchronise` wrote at ``now`` (s), with the
+    engine's radii and masses: nobody changed them since, and the queue is still valid."""
+    for k in range(body.shape[0]):
+        i = ident[k]
+        lag = now - body[k, STAMP]
+        if (
+            position[i, 0] != body[k, X] + body[k, VX] * lag
+            or position[i, 1] != body[k, Y] + body[k, VY] * lag
+            or velocity[i, 0] != body[k, VX]
+            or velocity[i, 1] != body[k, VY]
+            or radius[i] != body[k, RADIUS]
+            or mass[i] != body[k, MASS]
+        ):
+            return False
+    return True

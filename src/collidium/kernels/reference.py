@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from collidium.state import FloatArray
+from collidium.state import FloatArray, IntArray
 
 
 def elastic_response(
@@ -56,6 +56,20 @@ def coulomb_direct(
     virial = 0.5 * np.sum(k * qq * inv**3 * distance2, axis=1)
     return force, 0.5 * np.sum(k * qq * inv, axis=1), virial
 
+
+
+def coulomb_direct_on(
+    position: FloatArray, charge: FloatArray, k: float, softening2: float, targets: IntArray
+) -> FloatArray:
+    """Coulomb forces (M, 2) in N on the particles ``targets`` (M,) from all others, one target
+    at a time (O(M N) time, O(N) memory: for checking large systems on a sample)."""
+    force = np.empty((len(targets), 2))
+    for row, i in enumerate(targets):
+        d = position[i] - position
+        r2 = np.einsum("ij,ij->i", d, d) + softening2
+        r2[i] = np.inf
+        force[row] = k * charge[i] * ((charge / r2**1.5) @ d)
+    return force
 
 def first_overlap(position: FloatArray, radius: FloatArray) -> tuple[int, int]:
     """The overlapping pair with the smallest (i, j), or (-1, -1); all pairs, reflecting box."""
@@ -251,3 +265,121 @@ def first_invalid(
         return -1, 0
     i = int(bad[0])
     return i, 1 if not finite[i] else 2
+
+
+def coulomb_tree(
+    position: FloatArray,
+    charge: FloatArray,
+    k: float,
+    softening2: float,
+    theta: float,
+    leaf_size: int,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Twin of `tree.coulomb_tree`: forces (N, 2), half pair energies (N,) and half pair virials
+    (N,) by the same Barnes-Hut quadtree (same Morton cells, leaves, node radii and opening
+    test), with each accepted node's order-4 Taylor expansion written out from its particles:
+    ``sum_n sum_k (-1)^n / (2^k k! (n-2k)!) D_(n-k)(R) sum_j q_j |d_j|^2k (d_j . R)^(n-2k)``,
+    ``D_m = 2^m g^(m)`` for the kernel g of each output."""
+    n = len(position)
+    force, energy, virial = np.zeros((n, 2)), np.zeros(n), np.zeros(n)
+    if n == 0:
+        return force, energy, virial
+    bits = 21
+    lo = position.min(axis=0)
+    side = float(np.max(position.max(axis=0) - lo))
+    side = side if side > 0 else 1.0
+    cell = np.clip(((position - lo) * ((1 << bits) / side)).astype(np.int64), 0, (1 << bits) - 1)
+    code = np.zeros(n, dtype=np.int64)
+    for b in range(bits):
+        code |= ((cell[:, 0] >> b) & 1) << (2 * b) | ((cell[:, 1] >> b) & 1) << (2 * b + 1)
+    order = np.argsort(code, kind="stable")
+
+    def build(members: np.ndarray) -> dict:
+        """Node of the smallest quadtree cell holding ``members`` (Morton-sorted indices)."""
+        level = bits - (int(code[members[0]] ^ code[members[-1]]).bit_length() + 1) // 2
+        size = side / (1 << level)
+        centre = lo + ((cell[members[0]] >> (bits - level)) + 0.5) * size
+        node = {"members": members, "centre": centre, "children": []}
+        if len(members) <= leaf_size or level == bits:
+            node["radius"] = np.sqrt(np.max(np.sum((position[members] - centre) ** 2, axis=1)))
+            return node
+        digit = (code[members] >> (2 * (bits - level - 1))) & 3
+        node["children"] = [build(members[digit == d]) for d in range(4) if np.any(digit == d)]
+        offsets = [c["centre"] - centre for c in node["children"]]
+        reach = max(
+            math.sqrt(o[0] * o[0] + o[1] * o[1]) + c["radius"]
+            for o, c in zip(offsets, node["children"], strict=True)
+        )
+        node["radius"] = min(reach, math.sqrt(2.0) * 0.5 * size)
+        return node
+
+    def leaves(node: dict) -> list[dict]:
+        return [node] if not node["children"] else [g for c in node["children"] for g in leaves(c)]
+
+    root = build(order)
+    for group in leaves(root):
+        targets = group["members"]
+        box_lo, box_hi = position[targets].min(axis=0), position[targets].max(axis=0)
+        near_members, far = [], []
+        pending = [root]
+        while pending:
+            node = pending.pop()
+            if not np.any(charge[node["members"]] != 0):
+                continue
+            gap = np.maximum(np.maximum(box_lo - node["centre"], 0.0), node["centre"] - box_hi)
+            if node["radius"] ** 2 < theta**2 * np.sum(gap**2):
+                far.append(node)
+            elif node["children"]:
+                pending.extend(node["children"])
+            else:
+                near_members.extend(node["members"])
+        near = np.array([j for j in near_members if charge[j] != 0], dtype=np.int64)
+        field, phi, w = np.zeros((len(targets), 2)), np.zeros(len(targets)), np.zeros(len(targets))
+        for t, i in enumerate(targets):
+            sources = near[near != i]
+            d = position[i] - position[sources]
+            r2 = np.sum(d**2, axis=1)
+            inv = 1.0 / np.sqrt(r2 + softening2)
+            field[t] = np.sum((charge[sources] * inv**3)[:, None] * d, axis=0)
+            phi[t] = np.sum(charge[sources] * inv)
+            w[t] = np.sum(charge[sources] * inv**3 * r2)
+        for node in far:
+            f, p, v = _expansion(position[targets] - node["centre"], node, position, charge,
+                                 softening2)  # fmt: skip
+            field, phi, w = field + f, phi + p, w + v
+        charged = charge[targets] != 0  # neutral targets keep exact zeros, as in the direct sum
+        kq = k * charge[targets[charged]]
+        force[targets[charged]] = kq[:, None] * field[charged]
+        energy[targets[charged]] = 0.5 * kq * phi[charged]
+        virial[targets[charged]] = 0.5 * kq * w[charged]
+    return force, energy, virial
+
+
+def _expansion(
+    r: FloatArray, node: dict, position: FloatArray, charge: FloatArray, softening2: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Order-4 expansion about a node's centre at the targets' offsets ``r`` (M, 2): field
+    ``-grad Phi`` (M, 2), potential ``Phi`` (M,) and virial sum (M,), per unit charge. With
+    ``g(s) = (s + eps^2)^(-1/2)``, ``D_m = 2^m g^(m) = (-1)^m (2m-1)!! h^(2m+1)``; the virial
+    kernel ``s (s+eps^2)^(-3/2)`` is ``g + 2 eps^2 g'``, whose ``D_m`` is ``D_m + eps^2 D_m+1``."""
+    d = position[node["members"]] - node["centre"]
+    q = charge[node["members"]]
+    h = 1.0 / np.sqrt(np.sum(r**2, axis=1) + softening2)
+
+    def big_d(m: int) -> FloatArray:
+        return (-1) ** m * math.prod(range(1, 2 * m, 2)) * h ** (2 * m + 1)
+
+    field, phi, w = np.zeros_like(r), np.zeros(len(r)), np.zeros(len(r))
+    projection = r @ d.T  # (M, members): d_j . R
+    for order in range(5):
+        for traces in range(order // 2 + 1):
+            rank = order - 2 * traces
+            c = (-1) ** order / (2**traces * math.factorial(traces) * math.factorial(rank))
+            weight = q * np.sum(d**2, axis=1) ** traces
+            t = (weight * projection**rank).sum(axis=1)
+            grad_t = rank * ((weight * projection ** max(rank - 1, 0)) @ d)
+            m = order - traces
+            phi += c * big_d(m) * t
+            w += c * (big_d(m) + softening2 * big_d(m + 1)) * t
+            field -= c * ((big_d(m + 1) * t)[:, None] * r + big_d(m)[:, None] * grad_t)
+    return field, phi, w

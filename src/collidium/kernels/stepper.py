@@ -1,36 +1,156 @@
 """The seed report's collision method: after a plain drift, resolve overlapping pairs.
 
-Overlapping pairs are found through the cell grid, then handled one by one in index order
-(i, then j): a pair is resolved only if it is still approaching with the velocities it has by then
-(seed 4.1: the directional check, and pairwise handling in a fixed order).
+Overlapping pairs are found through a cell grid, then handled one by one in index order (i, then j):
+a pair is resolved only if it is still approaching with the velocities it has by then (seed 4.1:
+the directional check, and pairwise handling in a fixed order).
+
+Finding the pairs is parallel, yet its result does not depend on the number of threads. The
+particles are kept sorted into cells, with copies of their centres (and radii) side by side in cell
+order: a counting sort the first time (`sort_into_cells`), then from one step to the next only the
+few particles that changed cell are moved (`update_cells`). Each pair of neighbouring cells is
+searched once, by one thread (`overlapping_pairs`), and the pairs found are sorted by their code
+``i * N + j``, which also makes the order of the particles within a cell irrelevant. Only the
+resolution, which touches the few overlapping pairs, is sequential.
+
+Work arrays of particle indices and cells may be int32 or int64 (int32 halves their memory
+traffic, which is most of the cost).
 """
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
-from collidium.kernels.cells import fill_cells
+from collidium.kernels.cells import grid_shape
 from collidium.kernels.collision import elastic_response
+
+#: Cast to an unsigned index. Numba wraps negative indices around; with an unsigned one it need
+#: not check, which makes the random reads of a gather about twice as fast.
+_u = numba.uint64
+
+#: Cells per particle the grid aims at (cells are never narrower than the largest diameter).
+CELLS_PER_PARTICLE = 1.0
+
+#: Cells are this much wider than the largest diameter, so that round-off in the cell index can
+#: never put two touching disks two cells apart.
+_CELL_MARGIN = 1e-9
+
+
+def step_grid(
+    width: float, height: float, max_diameter: float, n: int, periodic: bool
+) -> tuple[int, int, bool]:
+    """Grid for `sort_into_cells` and `overlapping_pairs`.
+
+    Parameters
+    ----------
+    width, height : float
+        Box sides in m.
+    max_diameter : float
+        Largest disk diameter in m.
+    n : int
+        Number of particles.
+    periodic : bool
+        Periodic box.
+
+    Returns
+    -------
+    tuple
+        ``(ncx, ncy, general)``. ``general`` asks for the search that visits every neighbour cell
+        under every periodic shift, as the seed's method did on its own grid: in a periodic box
+        of fewer than three cells a side, a pair can be met under two shifts and is then listed
+        twice, so that grid (`cells.grid_shape`) is kept there to list exactly the same pairs.
+    """
+    if max_diameter <= 0.0 or n < 2:
+        return 1, 1, True  # no pairs: every point is skipped, a lone disk meets none
+
+    old = grid_shape(width, height, max_diameter, n)
+    if periodic and min(old) < 3:
+        return old[0], old[1], True
+    cell = max(
+        max_diameter * (1.0 + _CELL_MARGIN), math.sqrt(width * height / (CELLS_PER_PARTICLE * n))
+    )
+    ncx = max(1, int(width // cell))
+    ncy = max(1, int(height // cell))
+    if periodic and min(ncx, ncy) < 3:
+        return old[0], old[1], True
+    return ncx, ncy, False
+
+
+@numba.njit(cache=True, inline="always")
+def _cell(x: float, half: float, cell: float, count: int) -> int:
+    """Index along one axis of the cell holding ``x`` (clamped), as `cells.cell_index`."""
+    k = math.floor((x + half) / cell)
+    return min(max(k, 0), count - 1)
 
 
 @numba.njit(cache=True)
-def overlapping_pairs(
+def chunk_count(n: int) -> int:
+    """Chunks of particles handled in parallel: a fixed number, whatever the thread count."""
+    return max(1, min(64, n // 4096))
+
+
+@numba.njit(cache=True, parallel=True)
+def radius_summary(radius: np.ndarray, copy: np.ndarray) -> tuple[bool, bool, float]:
+    """Compare the radii with ``copy`` (made equal if they differ) and summarise them.
+
+    Parameters
+    ----------
+    radius, copy : ndarray of float64, shape (N,)
+        Radii in m, and those seen last time.
+
+    Returns
+    -------
+    tuple
+        ``(changed, uniform, largest)``: whether they differ from ``copy``, whether all are equal,
+        and the largest radius in m (0 if none).
+    """
+    n = radius.shape[0]
+    chunks = chunk_count(n)
+    differs = np.zeros(chunks, dtype=np.bool_)
+    varies = np.zeros(chunks, dtype=np.bool_)
+    largest = np.zeros(chunks)
+    first = radius[0] if n > 0 else 0.0
+    for p in numba.prange(chunks):
+        big = 0.0
+        for i in range(_u(p * n // chunks), _u((p + 1) * n // chunks)):
+            r = radius[i]
+            big = max(big, r)
+            differs[p] |= r != copy[i]
+            varies[p] |= r != first
+        largest[p] = big
+    changed = differs.any()
+    if changed:
+        copy[:] = radius
+    return changed, not varies.any(), largest.max()
+
+
+@numba.njit(cache=True, parallel=True)
+def sort_into_cells(
     position: np.ndarray,
     radius: np.ndarray,
+    uniform: bool,
     width: float,
     height: float,
     ncx: int,
     ncy: int,
-    cell_of: np.ndarray,
-    head: np.ndarray,
-    next_: np.ndarray,
-    prev: np.ndarray,
-    cells: np.ndarray,
-    shifts: np.ndarray,
-    out: np.ndarray,
-) -> int:
-    """Overlapping pairs, encoded ``i * N + j`` (i < j) and sorted, written to ``out``.
+    band_index: np.ndarray,
+    band_xy: np.ndarray,
+    band_r: np.ndarray,
+    cursor: np.ndarray,
+    order: np.ndarray,
+    key: np.ndarray,
+    start: np.ndarray,
+    cell_xy: np.ndarray,
+    cell_r: np.ndarray,
+) -> None:
+    """Stable counting sort of the particles into cells ``c = cx + ncx * cy``, in two passes.
+
+    First into rows of cells (in parallel over chunks of particles, each chunk with its own row
+    counts), then each row into its cells (in parallel over rows). The result is unique, so it
+    does not depend on the number of threads. For a first sort; `update_cells` then follows the
+    particles from step to step.
 
     Parameters
     ----------
@@ -38,47 +158,667 @@ def overlapping_pairs(
         Centres in m, inside the box.
     radius : ndarray, shape (N,)
         Radii in m.
+    uniform : bool
+        All radii are equal: ``cell_r`` is left alone.
     width, height : float
-        Box sides in m (used for periodic shifts).
+        Box sides in m.
     ncx, ncy : int
         Grid shape.
-    cell_of, head, next_, prev : ndarray of int64
-        Work arrays for the cell lists (N,), (ncx*ncy,), (N,), (N,).
-    cells, shifts : ndarray of int64
-        Neighbour table from `cells.neighbour_table`.
-    out : ndarray of int64, shape (M,)
-        Receives the first ``min(count, M)`` pairs.
+    band_index : ndarray of int, shape (N,)
+        Work array (particles by row).
+    band_xy, band_r : ndarray of float64, shapes (N, 2) and (N,)
+        Work arrays (their centres and radii).
+    cursor : ndarray of int, shape (ncx * ncy,)
+        Work array.
+    order : ndarray of int, shape (N,)
+        Output: particle indices by cell, increasing within a cell.
+    key : ndarray of int, shape (N,)
+        Output: the cell of ``order[s]`` in entry ``s`` (non-decreasing).
+    start : ndarray of int, shape (ncx * ncy + 1,)
+        Output: the particles of cell ``c`` are at ``start[c]:start[c + 1]`` of ``order``.
+    cell_xy, cell_r : ndarray of float64, shapes (N, 2) and (N,)
+        Output: centre and radius of ``order[s]`` in entry ``s`` (m), read contiguously by the
+        search.
+    """
+    n = position.shape[0]
+    half_width = 0.5 * width
+    half_height = 0.5 * height
+    cw = 2.0 * half_width / ncx
+    ch = 2.0 * half_height / ncy
+    chunks = chunk_count(n)
+    rows = np.zeros((chunks, ncy), dtype=np.int64)
+    # Row of each particle (kept in `order` for now), counted per chunk.
+    for p in numba.prange(chunks):
+        for i in range(_u(p * n // chunks), _u((p + 1) * n // chunks)):
+            row = _cell(position[i, 1], half_height, ch, ncy)
+            order[i] = row
+            rows[p, row] += 1
+    # Where each chunk's share of each row begins: rows in order, chunks in order within a row.
+    row_start = np.empty(ncy + 1, dtype=np.int64)
+    filled = 0
+    for row in range(ncy):
+        row_start[row] = filled
+        for p in range(chunks):
+            count = rows[p, row]
+            rows[p, row] = filled
+            filled += count
+    row_start[ncy] = filled
+    for p in numba.prange(chunks):
+        for i in range(_u(p * n // chunks), _u((p + 1) * n // chunks)):
+            row = order[i]
+            s = _u(rows[p, row])
+            rows[p, row] += 1
+            band_index[s] = i
+            band_xy[s, 0] = position[i, 0]
+            band_xy[s, 1] = position[i, 1]
+            if not uniform:
+                band_r[s] = radius[i]
+    # Each row into its cells (rows hold particles in index order, so cells do too).
+    for row in numba.prange(ncy):
+        base = row * ncx
+        lo = _u(row_start[row])
+        hi = _u(row_start[row + 1])
+        for cx in range(ncx):
+            cursor[base + cx] = 0
+        for s in range(lo, hi):
+            cursor[base + _cell(band_xy[s, 0], half_width, cw, ncx)] += 1
+        at = row_start[row]
+        for cx in range(ncx):
+            count = cursor[base + cx]
+            start[base + cx] = at
+            cursor[base + cx] = at
+            at += count
+        for s in range(lo, hi):
+            c = base + _cell(band_xy[s, 0], half_width, cw, ncx)
+            t = _u(cursor[c])
+            cursor[c] += 1
+            order[t] = band_index[s]
+            key[t] = c
+            cell_xy[t, 0] = band_xy[s, 0]
+            cell_xy[t, 1] = band_xy[s, 1]
+            if not uniform:
+                cell_r[t] = band_r[s]
+    start[ncx * ncy] = n
+
+
+@numba.njit(cache=True)
+def _gather_chunk(
+    position: np.ndarray,
+    radius: np.ndarray,
+    fresh_radius: bool,
+    uniform: bool,
+    half_width: float,
+    half_height: float,
+    cw: float,
+    ch: float,
+    ncx: int,
+    ncy: int,
+    order: np.ndarray,
+    key: np.ndarray,
+    cell_r: np.ndarray,
+    data_xy: np.ndarray,
+    data_r: np.ndarray,
+    new_key: np.ndarray,
+    movers: np.ndarray,
+    lo: int,
+    hi: int,
+) -> int:
+    """`_gather` for slots ``lo:hi``: returns the number of movers listed from ``movers[lo]``."""
+    # The random reads alone first, so that many are in flight at once.
+    for s in range(_u(lo), _u(hi)):
+        i = _u(order[s])
+        data_xy[s, 0] = position[i, 0]
+        data_xy[s, 1] = position[i, 1]
+    if fresh_radius and not uniform:
+        for s in range(_u(lo), _u(hi)):
+            data_r[s] = radius[_u(order[s])]
+    elif not uniform:
+        for s in range(_u(lo), _u(hi)):
+            data_r[s] = cell_r[s]
+    count = 0
+    for s in range(lo, hi):
+        us = _u(s)
+        x = data_xy[us, 0]
+        y = data_xy[us, 1]
+        c = _cell(x, half_width, cw, ncx) + ncx * _cell(y, half_height, ch, ncy)
+        new_key[us] = c
+        if c != key[us]:
+            movers[_u(lo + count)] = s
+            count += 1
+    return count
+
+
+@numba.njit(cache=True, parallel=True)
+def _gather(
+    position: np.ndarray,
+    radius: np.ndarray,
+    fresh_radius: bool,
+    uniform: bool,
+    width: float,
+    height: float,
+    ncx: int,
+    ncy: int,
+    order: np.ndarray,
+    key: np.ndarray,
+    cell_r: np.ndarray,
+    data_xy: np.ndarray,
+    data_r: np.ndarray,
+    new_key: np.ndarray,
+    movers: np.ndarray,
+    moved: np.ndarray,
+) -> None:
+    """Centres (and radii) and cells of the particles in last step's cell order; list movers.
+
+    Chunk ``p`` of the slots lists the slots whose particle changed cell from ``movers[lo_p]``
+    on, and their number in ``moved[p]``. Radii are taken from last step's ``cell_r`` unless
+    ``fresh_radius``, and not at all if ``uniform``.
+    """
+    n = order.shape[0]
+    chunks = moved.shape[0]
+    half_width = 0.5 * width
+    half_height = 0.5 * height
+    cw = 2.0 * half_width / ncx
+    ch = 2.0 * half_height / ncy
+    for p in numba.prange(chunks):
+        moved[p] = _gather_chunk(
+            position, radius, fresh_radius, uniform, half_width, half_height, cw, ch, ncx, ncy,
+            order, key, cell_r, data_xy, data_r, new_key, movers, p * n // chunks,
+            (p + 1) * n // chunks,
+        )  # fmt: skip
+
+
+@numba.njit(cache=True)
+def _sort_movers(movers: np.ndarray, new_key: np.ndarray) -> None:
+    """Stable sort of the movers by their new cell.
+
+    They come in slot order, so by their old cell, and most moved to a neighbouring cell: an
+    insertion sort has little to do. Past a budget of shifts, a merge sort takes over.
+    """
+    m = movers.shape[0]
+    budget = 64 * m + 1024
+    for t in range(1, m):
+        s = movers[t]
+        c = new_key[_u(s)]
+        u = t
+        while u > 0 and new_key[_u(movers[u - 1])] > c:
+            movers[u] = movers[u - 1]
+            u -= 1
+        movers[u] = s
+        budget -= t - u
+        if budget < 0:
+            movers[:] = movers[np.argsort(new_key[movers], kind="mergesort")]
+            return
+
+
+@numba.njit(cache=True)
+def _first_mover_at_or_after(movers: np.ndarray, new_key: np.ndarray, cell: int) -> int:
+    """Binary search: the first of the movers (sorted by new cell) bound for ``cell`` or later."""
+    lo = 0
+    hi = movers.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if new_key[_u(movers[mid])] < cell:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@numba.njit(cache=True)
+def _merge_range(
+    order: np.ndarray,
+    key: np.ndarray,
+    data_xy: np.ndarray,
+    data_r: np.ndarray,
+    uniform: bool,
+    new_key: np.ndarray,
+    movers: np.ndarray,
+    slot_lo: int,
+    slot_hi: int,
+    mover_lo: int,
+    mover_hi: int,
+    out: int,
+    cell_lo: int,
+    cell_hi: int,
+    order_out: np.ndarray,
+    key_out: np.ndarray,
+    start: np.ndarray,
+    cell_xy: np.ndarray,
+    cell_r: np.ndarray,
+) -> None:
+    """Merge the stayers of slots ``slot_lo:slot_hi`` with ``movers[mover_lo:mover_hi]`` into
+    the slots from ``out`` on, and write ``start`` for cells ``cell_lo:cell_hi``."""
+    s = slot_lo
+    m = mover_lo
+    t = out
+    while True:
+        while s < slot_hi and new_key[_u(s)] != key[_u(s)]:  # a mover: merged from the list
+            s += 1
+        if s < slot_hi and (m == mover_hi or new_key[_u(s)] <= new_key[_u(movers[_u(m)])]):
+            src = _u(s)
+            s += 1
+        elif m < mover_hi:
+            src = _u(movers[_u(m)])
+            m += 1
+        else:
+            break
+        ut = _u(t)
+        order_out[ut] = order[src]
+        key_out[ut] = new_key[src]
+        cell_xy[ut, 0] = data_xy[src, 0]
+        cell_xy[ut, 1] = data_xy[src, 1]
+        if not uniform:
+            cell_r[ut] = data_r[src]
+        t += 1
+    _fill_start(key_out, out, t, cell_lo, cell_hi, start)
+
+
+@numba.njit(cache=True)
+def _fill_start(
+    key: np.ndarray, lo: int, hi: int, cell_lo: int, cell_hi: int, start: np.ndarray
+) -> None:
+    """``start[c]`` for cells ``cell_lo:cell_hi``, whose particles are slots ``lo:hi`` (sorted
+    by cell in ``key``). Without branches on the cell sizes, which vary at random."""
+    for c in range(_u(cell_lo), _u(cell_hi)):
+        start[c] = hi
+    for t in range(hi - 1, lo - 1, -1):  # backwards: the first slot of a cell is written last
+        start[_u(key[_u(t)])] = t
+    following = hi
+    for c in range(cell_hi - 1, cell_lo - 1, -1):  # empty cells start where the next one does
+        following = min(start[_u(c)], following)
+        start[_u(c)] = following
+
+
+@numba.njit(cache=True, parallel=True)
+def update_cells(
+    position: np.ndarray,
+    radius: np.ndarray,
+    fresh_radius: bool,
+    uniform: bool,
+    width: float,
+    height: float,
+    ncx: int,
+    ncy: int,
+    order: np.ndarray,
+    key: np.ndarray,
+    data_xy: np.ndarray,
+    data_r: np.ndarray,
+    new_key: np.ndarray,
+    movers: np.ndarray,
+    moved: np.ndarray,
+    order_out: np.ndarray,
+    key_out: np.ndarray,
+    start: np.ndarray,
+    cell_xy: np.ndarray,
+    cell_r: np.ndarray,
+) -> bool:
+    """Sort the particles into cells again, starting from the order of the step before.
+
+    Particles move little in one step: the ones still in the same cell keep their order, the
+    few that changed cell are sorted and merged in, in parallel over ranges of cells. Within a
+    cell the order then depends on the history, which the pair search does not see (it sorts
+    the pairs it finds); the result does not depend on the number of threads.
+
+    Parameters
+    ----------
+    position : ndarray, shape (N, 2)
+        Centres in m, inside the box.
+    radius : ndarray, shape (N,)
+        Radii in m.
+    fresh_radius : bool
+        The radii changed since the step before: read them from ``radius``, not ``cell_r``.
+    uniform : bool
+        All radii are equal: ``cell_r`` is left alone.
+    width, height : float
+        Box sides in m.
+    ncx, ncy : int
+        Grid shape.
+    order, key : ndarray of int, shape (N,)
+        Last step's `order_out` and `key_out` (or the output of `sort_into_cells`).
+    data_xy, data_r : ndarray of float64, shapes (N, 2) and (N,)
+        Work arrays.
+    new_key, movers : ndarray of int, shape (N,)
+        Work arrays.
+    moved : ndarray of int64, shape (P,)
+        Work array, ``P = chunk_count(N)``.
+    order_out, key_out : ndarray of int, shape (N,)
+        Output: particle index and cell in each slot, by cell.
+    start : ndarray of int, shape (ncx * ncy + 1,)
+        Output: the particles of cell ``c`` are at ``start[c]:start[c + 1]`` of ``order_out``.
+    cell_xy, cell_r : ndarray of float64, shapes (N, 2) and (N,)
+        Output: centre and radius of ``order_out[s]`` in entry ``s`` (m). On entry, ``cell_r``
+        holds last step's radii.
+
+    Returns
+    -------
+    bool
+        False (outputs unset) if so many particles changed cell that `sort_into_cells` is the
+        faster way.
+    """
+    n = order.shape[0]
+    ncells = ncx * ncy
+    _gather(
+        position, radius, fresh_radius, uniform, width, height, ncx, ncy, order, key, cell_r,
+        data_xy, data_r, new_key, movers, moved,
+    )  # fmt: skip
+    chunks = moved.shape[0]
+    count = 0
+    for p in range(chunks):  # the chunks' movers, one after the other (in slot order)
+        lo = p * n // chunks
+        for k in range(moved[p]):
+            movers[count + k] = movers[lo + k]
+        count += moved[p]
+    if count > n // 8:
+        return False
+    # Ranges merged in parallel: the slots of whole cells, about n / chunks of them each.
+    slot_at = np.empty(chunks + 1, dtype=np.int64)
+    cell_at = np.empty(chunks + 1, dtype=np.int64)
+    below = np.empty(chunks + 1, dtype=np.int64)  # movers from slots before slot_at
+    for p in range(chunks + 1):
+        s = p * n // chunks
+        while 0 < s < n and key[s - 1] == key[s]:
+            s -= 1
+        slot_at[p] = s
+        cell_at[p] = 0 if p == 0 else (ncells if p == chunks else key[s])
+        below[p] = np.searchsorted(movers[:count], s)
+    sorted_movers = movers[:count]
+    _sort_movers(sorted_movers, new_key)
+    for p in numba.prange(chunks):
+        first = _first_mover_at_or_after(sorted_movers, new_key, cell_at[p])
+        last = _first_mover_at_or_after(sorted_movers, new_key, cell_at[p + 1])
+        _merge_range(
+            order, key, data_xy, data_r, uniform, new_key, sorted_movers, slot_at[p],
+            slot_at[p + 1], first, last, slot_at[p] - below[p] + first, cell_at[p],
+            cell_at[p + 1], order_out, key_out, start, cell_xy, cell_r,
+        )  # fmt: skip
+    start[ncells] = n
+    return True
+
+
+@numba.njit(cache=True)
+def _scan_shifted(
+    a: int, lo: int, hi: int, sx: float, sy: float, width: float, height: float,
+    order: np.ndarray, cell_xy: np.ndarray, cell_r: np.ndarray, uniform: bool, r0: float,
+    found: np.ndarray, base: int, cap: int, count: int,
+) -> int:  # fmt: skip
+    """Pairs of slot ``a`` with slots ``lo:hi`` of a cell whose particles are seen shifted by
+    ``(sx * width, sy * height)`` (across a periodic edge).
+
+    The separation is computed as the seed's search did, from the lower index i to the image of
+    j, so that the overlap test rounds exactly as it did.
+    """
+    n = order.shape[0]
+    ia = order[a]
+    xa = cell_xy[a, 0]
+    ya = cell_xy[a, 1]
+    ra = r0 if uniform else cell_r[a]
+    for b in range(lo, hi):
+        ib = order[b]
+        xb = cell_xy[b, 0]
+        yb = cell_xy[b, 1]
+        rb = r0 if uniform else cell_r[b]
+        if ia < ib:
+            dx = (xb + sx * width) - xa
+            dy = (yb + sy * height) - ya
+        else:
+            dx = (xa - sx * width) - xb
+            dy = (ya - sy * height) - yb
+        sigma = ra + rb
+        if dx * dx + dy * dy < sigma * sigma and rb > 0.0:
+            if count < cap:
+                found[base + count] = min(ia, ib) * n + max(ia, ib)
+            count += 1
+    return count
+
+
+@numba.njit(cache=True)
+def _search_row(
+    cy: int, start: np.ndarray, order: np.ndarray, cell_xy: np.ndarray, cell_r: np.ndarray,
+    uniform: bool, r0: float, ncx: int, ncy: int, width: float, height: float, periodic: bool,
+    found: np.ndarray, base: int, cap: int, count: int,
+) -> int:  # fmt: skip
+    """Overlapping pairs met from row ``cy``: each cell against itself, its east neighbour and
+    the three cells above (a half shell, so each pair of neighbour cells is searched once).
+
+    Pairs are written to ``found[base:base + cap]`` from entry ``count`` on (counted even when
+    they do not fit); returns the new count.
+    """
+    n = order.shape[0]
+    row = cy * ncx
+    above = cy + 1
+    wrapped_above = above == ncy  # the row above lies across the periodic edge
+    if wrapped_above:
+        above = 0
+    up = above * ncx
+    has_above = periodic or not wrapped_above
+    for cx in range(ncx):
+        c = row + cx
+        # Unshifted neighbours, in two contiguous runs of slots: the rest of this cell with the
+        # east cell, and the cells above (those across a periodic edge are searched below).
+        east_end = start[_u(c + 2)] if cx + 1 < ncx else start[_u(c + 1)]
+        above_lo = 0
+        above_hi = 0
+        if has_above and not wrapped_above:
+            above_lo = start[_u(up + max(cx - 1, 0))]
+            above_hi = start[_u(up + min(cx + 1, ncx - 1) + 1)]
+        edge = periodic and (cx == 0 or cx + 1 == ncx or wrapped_above)
+        for a in range(start[_u(c)], start[_u(c + 1)]):
+            ua = _u(a)
+            xa = cell_xy[ua, 0]
+            ya = cell_xy[ua, 1]
+            ra = r0 if uniform else cell_r[ua]
+            if ra <= 0.0:  # points take no part in collisions
+                continue
+            # One loop over both runs (fewer mispredicted loop exits than two loops).
+            skip = above_lo - east_end  # from the end of the first run to the second
+            for k in range(a + 1, east_end + above_hi - above_lo):
+                b = _u(k if k < east_end else k + skip)
+                # Computed from a's side whatever the index order: the square is the same.
+                dx = cell_xy[b, 0] - xa
+                dy = cell_xy[b, 1] - ya
+                rb = r0 if uniform else cell_r[b]
+                sigma = ra + rb
+                if dx * dx + dy * dy < sigma * sigma and rb > 0.0:
+                    i = min(order[ua], order[b])
+                    j = max(order[ua], order[b])
+                    if count < cap:
+                        found[base + count] = i * n + j
+                    count += 1
+            if edge:
+                count = _search_edges(
+                    a, cx, cy, start, order, cell_xy, cell_r, uniform, r0, ncx, width, height,
+                    up, wrapped_above, found, base, cap, count,
+                )  # fmt: skip
+    return count
+
+
+@numba.njit(cache=True)
+def _search_edges(
+    a: int, cx: int, cy: int, start: np.ndarray, order: np.ndarray, cell_xy: np.ndarray,
+    cell_r: np.ndarray, uniform: bool, r0: float, ncx: int, width: float, height: float,
+    up: int, wrapped_above: bool, found: np.ndarray, base: int, cap: int, count: int,
+) -> int:  # fmt: skip
+    """The half-shell neighbours of slot ``a`` (cell ``cx, cy``) across a periodic edge."""
+    sy = 1.0 if wrapped_above else 0.0
+    if cx + 1 == ncx:  # east, across the right edge
+        row = cy * ncx
+        count = _scan_shifted(
+            a, start[row], start[row + 1], 1.0, 0.0, width, height, order, cell_xy, cell_r,
+            uniform, r0, found, base, cap, count,
+        )  # fmt: skip
+    for ox in range(-1, 2):
+        nx = cx + ox
+        sx = 0.0
+        if nx < 0:
+            nx += ncx
+            sx = -1.0
+        elif nx >= ncx:
+            nx -= ncx
+            sx = 1.0
+        if sx != 0.0 or sy != 0.0:
+            count = _scan_shifted(
+                a, start[up + nx], start[up + nx + 1], sx, sy, width, height, order, cell_xy,
+                cell_r, uniform, r0, found, base, cap, count,
+            )  # fmt: skip
+    return count
+
+
+@numba.njit(cache=True)
+def _search_row_general(
+    cy: int, start: np.ndarray, order: np.ndarray, cell_xy: np.ndarray, cell_r: np.ndarray,
+    uniform: bool, r0: float, ncx: int, ncy: int, width: float, height: float, periodic: bool,
+    found: np.ndarray, base: int, cap: int, count: int,
+) -> int:  # fmt: skip
+    """Overlapping pairs ``(i, j)``, j > i, met from each i of row ``cy`` in its 9 neighbour
+    cells, under the periodic shift of each (a cell may appear under several shifts)."""
+    n = order.shape[0]
+    for cx in range(ncx):
+        c = cx + ncx * cy
+        for a in range(start[c], start[c + 1]):
+            i = order[a]
+            xi = cell_xy[a, 0]
+            yi = cell_xy[a, 1]
+            ri = r0 if uniform else cell_r[a]
+            if ri <= 0.0:
+                continue
+            for oy in range(-1, 2):
+                ny = cy + oy
+                if not periodic and (ny < 0 or ny >= ncy):
+                    continue
+                sy = (ny - ny % ncy) // ncy
+                for ox in range(-1, 2):
+                    nx = cx + ox
+                    if not periodic and (nx < 0 or nx >= ncx):
+                        continue
+                    sx = (nx - nx % ncx) // ncx
+                    nc = nx % ncx + ncx * (ny % ncy)
+                    for b in range(start[nc], start[nc + 1]):
+                        j = order[b]
+                        rj = r0 if uniform else cell_r[b]
+                        if j > i and rj > 0.0:
+                            dx = cell_xy[b, 0] + sx * width - xi
+                            dy = cell_xy[b, 1] + sy * height - yi
+                            sigma = ri + rj
+                            if dx * dx + dy * dy < sigma * sigma:
+                                if count < cap:
+                                    found[base + count] = i * n + j
+                                count += 1
+    return count
+
+
+@numba.njit(cache=True, parallel=True)
+def overlapping_pairs(
+    start: np.ndarray,
+    order: np.ndarray,
+    cell_xy: np.ndarray,
+    cell_r: np.ndarray,
+    uniform: bool,
+    r0: float,
+    ncx: int,
+    ncy: int,
+    width: float,
+    height: float,
+    periodic: bool,
+    general: bool,
+    chunks: int,
+    found: np.ndarray,
+    scratch: np.ndarray,
+) -> int:
+    """Overlapping pairs, encoded ``i * N + j`` (i < j) and sorted, written to ``found``.
+
+    Parameters
+    ----------
+    start, order : ndarray of int
+        The particles sorted into cells, as from `sort_into_cells` or `update_cells`.
+    cell_xy, cell_r : ndarray of float64, shapes (N, 2) and (N,)
+        Their centres and radii in m, in the same order (``cell_r`` unused if ``uniform``).
+    uniform : bool
+        All radii equal ``r0`` (m).
+    r0 : float
+        The radius of all particles when ``uniform``, in m.
+    ncx, ncy : int
+        Grid shape.
+    width, height : float
+        Box sides in m (for periodic shifts).
+    periodic : bool
+        Periodic box: neighbour cells wrap around.
+    general : bool
+        Use the search that visits every neighbour cell under every shift (see `step_grid`).
+    chunks : int
+        Number of bands of rows searched in parallel, 1 to ``ncy``; each fills its own
+        ``found.shape[0] // chunks`` entries of ``found``.
+    found : ndarray of int64, shape (M,)
+        Output: the sorted pair codes at ``found[:count]`` when the return value is ``count >= 0``.
+    scratch : ndarray of int64, shape (M,)
+        Work array for the sort.
 
     Returns
     -------
     int
-        The number of overlapping pairs; if larger than M, call again with a larger ``out``.
+        The number of overlapping pairs, or ``-need`` if a band found ``need`` pairs, more than
+        its share: call again with ``found`` of at least ``chunks * need`` entries.
     """
-    n = position.shape[0]
-    fill_cells(position, radius, 0.5 * width, 0.5 * height, ncx, ncy, cell_of, head, next_, prev)
-    count = 0
-    for i in range(n):
-        ci = cell_of[i]
-        if radius[i] <= 0.0:  # points take no part in collisions
-            continue
-        for k in range(9):
-            c = cells[ci, k]
-            if c < 0:
-                continue
-            j = head[c]
-            while j >= 0:
-                if j > i and radius[j] > 0.0:
-                    dx = position[j, 0] + shifts[ci, k, 0] * width - position[i, 0]
-                    dy = position[j, 1] + shifts[ci, k, 1] * height - position[i, 1]
-                    sigma = radius[i] + radius[j]
-                    if dx * dx + dy * dy < sigma * sigma:
-                        if count < out.shape[0]:
-                            out[count] = i * n + j
-                        count += 1
-                j = next_[j]
-    if count <= out.shape[0]:
-        out[:count].sort()
-    return count
+    if uniform and r0 <= 0.0:
+        return 0
+    cap = found.shape[0] // chunks
+    counts = np.zeros(chunks, dtype=np.int64)
+    for k in numba.prange(chunks):
+        base = k * cap
+        count = 0
+        for cy in range(k * ncy // chunks, (k + 1) * ncy // chunks):
+            if general:
+                count = _search_row_general(
+                    cy, start, order, cell_xy, cell_r, uniform, r0, ncx, ncy, width, height,
+                    periodic, found, base, cap, count,
+                )  # fmt: skip
+            else:
+                count = _search_row(
+                    cy, start, order, cell_xy, cell_r, uniform, r0, ncx, ncy, width, height,
+                    periodic, found, base, cap, count,
+                )  # fmt: skip
+        counts[k] = count
+    need = counts.max()
+    if need > cap:
+        return -need
+    # Gather the bands' pairs at the front (moving left only), then put them in index order.
+    total = 0
+    for k in range(chunks):
+        for m in range(counts[k]):
+            found[total + m] = found[k * cap + m]
+        total += counts[k]
+    _radix_sort(found[:total], scratch[:total], order.shape[0])
+    return total
+
+
+@numba.njit(cache=True)
+def _radix_sort(codes: np.ndarray, scratch: np.ndarray, n: int) -> None:
+    """Sort pair codes ``i * n + j`` in place, 11 bits a pass (a comparison sort of random codes
+    mispredicts a branch per comparison)."""
+    if codes.shape[0] < 256:
+        codes.sort()
+        return
+    bits = 1
+    while (1 << bits) < n * n:
+        bits += 1
+    count = np.empty(2048, dtype=np.int64)
+    source = codes
+    target = scratch
+    for shift in range(0, bits, 11):
+        count[:] = 0
+        for v in source:
+            count[(v >> shift) & 2047] += 1
+        total = 0
+        for d in range(2048):
+            c = count[d]
+            count[d] = total
+            total += c
+        for v in source:
+            d = (v >> shift) & 2047
+            target[_u(count[d])] = v
+            count[d] += 1
+        source, target = target, source
+    if source is not codes:
+        codes[:] = source
 
 
 @numba.njit(cache=True)

@@ -47,7 +47,73 @@ def fold(x: float, v: float, lo: float, hi: float) -> tuple[float, float, int]:
     return min(max(x, lo), hi), v, bounces
 
 
+#: Particles per chunk of the parallel drift. A chunk runs in parallel up to its first particle
+#: that meets a wall; the rest of it is finished afterwards, in index order, so that the sums of
+#: the wall tallies are the same whatever the number of threads.
+DRIFT_CHUNK = 1024
+
+
 @numba.njit(cache=True)
+def _drift_free(
+    position: np.ndarray,
+    velocity: np.ndarray,
+    radius: np.ndarray,
+    half_width: float,
+    half_height: float,
+    dt: float,
+    lo: int,
+    hi: int,
+) -> int:
+    """Drift particles ``lo:hi`` until the first that would meet a wall; return its index (or
+    ``hi``). That particle and the ones after it are left untouched."""
+    for i in range(lo, hi):
+        x = position[i, 0] + velocity[i, 0] * dt
+        y = position[i, 1] + velocity[i, 1] * dt
+        inside_x = -half_width + radius[i] <= x <= half_width - radius[i]
+        if not (inside_x and -half_height + radius[i] <= y <= half_height - radius[i]):
+            return i
+        position[i, 0] = x
+        position[i, 1] = y
+    return hi
+
+
+@numba.njit(cache=True)
+def _drift_folding(
+    position: np.ndarray,
+    velocity: np.ndarray,
+    radius: np.ndarray,
+    mass: np.ndarray,
+    half_width: float,
+    half_height: float,
+    dt: float,
+    wall_hits: np.ndarray,
+    wall_impulse: np.ndarray,
+    lo: int,
+    hi: int,
+) -> None:
+    """Drift particles ``lo:hi`` in index order, folding them back and tallying wall hits."""
+    half = (half_width, half_height)
+    for i in range(lo, hi):
+        for d in range(2):
+            x = position[i, d] + velocity[i, d] * dt
+            low = -half[d] + radius[i]
+            high = half[d] - radius[i]
+            moving_up = velocity[i, d] > 0.0
+            x, v, bounces = fold(x, velocity[i, d], low, high)
+            position[i, d] = x
+            velocity[i, d] = v
+            if bounces > 0:
+                # Bounces alternate between the two walls, starting with the one moved towards.
+                first = 2 * d + (1 if moving_up else 0)
+                other = 2 * d + (0 if moving_up else 1)
+                kick = 2.0 * mass[i] * abs(v)
+                wall_hits[first] += (bounces + 1) // 2
+                wall_hits[other] += bounces // 2
+                wall_impulse[first] += kick * ((bounces + 1) // 2)
+                wall_impulse[other] += kick * (bounces // 2)
+
+
+@numba.njit(cache=True, parallel=True)
 def drift_reflecting(
     position: np.ndarray,
     velocity: np.ndarray,
@@ -60,6 +126,10 @@ def drift_reflecting(
     wall_impulse: np.ndarray,
 ) -> None:
     """Move every particle by ``velocity * dt`` and fold it back inside the walls.
+
+    Parallel over chunks of `DRIFT_CHUNK` particles; the (few) particles from the first one of a
+    chunk that meets a wall are drifted afterwards, in index order, so the wall tallies are summed
+    in index order and the result does not depend on the number of threads.
 
     Parameters
     ----------
@@ -78,28 +148,24 @@ def drift_reflecting(
     wall_impulse : ndarray of float64, shape (4,)
         Incremented by the momentum each wall receives, ``2 m |v|`` per bounce (kg m/s).
     """
-    half = (half_width, half_height)
-    for i in range(position.shape[0]):
-        for d in range(2):
-            x = position[i, d] + velocity[i, d] * dt
-            lo = -half[d] + radius[i]
-            hi = half[d] - radius[i]
-            moving_up = velocity[i, d] > 0.0
-            x, v, bounces = fold(x, velocity[i, d], lo, hi)
-            position[i, d] = x
-            velocity[i, d] = v
-            if bounces > 0:
-                # Bounces alternate between the two walls, starting with the one moved towards.
-                first = 2 * d + (1 if moving_up else 0)
-                other = 2 * d + (0 if moving_up else 1)
-                kick = 2.0 * mass[i] * abs(v)
-                wall_hits[first] += (bounces + 1) // 2
-                wall_hits[other] += bounces // 2
-                wall_impulse[first] += kick * ((bounces + 1) // 2)
-                wall_impulse[other] += kick * (bounces // 2)
+    n = position.shape[0]
+    chunks = (n + DRIFT_CHUNK - 1) // DRIFT_CHUNK
+    stopped = np.empty(chunks, dtype=np.int64)
+    for k in numba.prange(chunks):
+        hi = min(n, (k + 1) * DRIFT_CHUNK)
+        stopped[k] = _drift_free(
+            position, velocity, radius, half_width, half_height, dt, k * DRIFT_CHUNK, hi
+        )
+    for k in range(chunks):
+        hi = min(n, (k + 1) * DRIFT_CHUNK)
+        if stopped[k] < hi:
+            _drift_folding(
+                position, velocity, radius, mass, half_width, half_height, dt, wall_hits,
+                wall_impulse, stopped[k], hi,
+            )  # fmt: skip
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, parallel=True)
 def drift_periodic(
     position: np.ndarray,
     velocity: np.ndarray,
@@ -108,7 +174,7 @@ def drift_periodic(
     height: float,
     dt: float,
 ) -> None:
-    """Move every particle by ``velocity * dt`` and wrap it into the primary cell.
+    """Move every particle by ``velocity * dt`` and wrap it into the primary cell (in parallel).
 
     Parameters
     ----------
@@ -122,7 +188,7 @@ def drift_periodic(
         Time step in s.
     """
     size = (width, height)
-    for i in range(position.shape[0]):
+    for i in numba.prange(position.shape[0]):
         for d in range(2):
             x = position[i, d] + velocity[i, d] * dt
             shift = math.floor((x + 0.5 * size[d]) / size[d])
