@@ -114,7 +114,7 @@ def test_pymunk_balls():
     pytest.importorskip("pymunk")
     result = peers.pymunk_balls(300, steps=50)
     json.dumps(result)
-    assert result["steps"] == 50
+    assert result["isolated"] is False and result["steps"] == 50
     assert result["particle_steps_per_second"] > 0
     assert result["wall_seconds_per_simulated_second"] == pytest.approx(
         result["seconds"] / (50 * 0.01)
@@ -123,3 +123,10 @@ def test_pymunk_balls():
     hashed = peers.pymunk_balls(300, max_seconds=0.2, spatial_hash=0.5)
     assert hashed["broadphase"].startswith("spatial hash")
     assert hashed["steps"] >= 1 and math.isfinite(hashed["seconds_per_step"])
+
+
+def test_pymunk_balls_in_a_child_process():
+    pytest.importorskip("pymunk")
+    result = peers.pymunk_balls(200, steps=10, isolate=True)
+    assert result["isolated"] is True and result["steps"] == 10 and result["n"] == 200
+    assert result["particle_steps_per_second"] > 0

@@ -23,7 +23,7 @@ import numpy as np
 from collidium.containers import Box
 from collidium.errors import SimulationError
 from collidium.kernels import events, stepper, walls
-from collidium.kernels.cells import event_grid_shape, grid_shape, neighbour_table
+from collidium.kernels.cells import event_grid_shape
 from collidium.state import FloatArray, IntArray, Particles
 
 CollisionMode = Literal["exact", "step", "off"]
@@ -92,21 +92,6 @@ def make_drift(mode: CollisionMode) -> Drift:
 
 
 _NO_ACCELERATION = np.empty((0, 2))
-
-
-class _Grid:
-    """Cell grid sized for the particles' largest diameter, with work arrays."""
-
-    def __init__(self, particles: Particles, box: Box) -> None:
-        n = particles.n
-        diameter = 2.0 * float(particles.radius.max(initial=0.0))
-        self.shape = grid_shape(box.width, box.height, diameter, n)
-        ncx, ncy = self.shape
-        self.cells, self.shifts = neighbour_table(ncx, ncy, box.periodic)
-        self.cell_of = np.empty(n, dtype=np.int64)
-        self.head = np.empty(ncx * ncy, dtype=np.int64)
-        self.next = np.empty(n, dtype=np.int64)
-        self.prev = np.empty(n, dtype=np.int64)
 
 
 def _free_flight(particles: Particles, box: Box, dt: float, tally: Tally) -> None:
@@ -254,12 +239,14 @@ class StepCollisions(_Stateless):
         # Cells must stay at least a diameter wide; they are kept if the disks shrink.
         if layout != self._layout or 2.0 * largest > self._diameter:
             self._make_grid(particles, box, 2.0 * largest)
+            changed = True
+        if uniform and changed:  # equal radii: the same in every order, left alone by the sort
+            self._cell_r.fill(largest)
         self._sort(particles, box, changed, uniform)
         while True:
             count = stepper.overlapping_pairs(
-                self._start, self._order, self._cell_xy, self._cell_r, uniform,
-                float(particles.radius[0]), *self._shape, box.width, box.height, box.periodic,
-                self._general, self._chunks, self._pairs, self._scratch,
+                self._start, self._order, self._cell_xy, self._cell_r, *self._shape, box.width,
+                box.height, box.periodic, self._general, self._chunks, self._pairs, self._scratch,
             )  # fmt: skip
             if count >= 0:
                 break

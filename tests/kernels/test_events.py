@@ -88,7 +88,8 @@ def test_engine_matches_twin_across_cell_crossings(rng):
     velocity = rng.uniform(-10, 10, (n, 2))
     radius = np.full(n, 0.001)
     sim = Simulation(
-        Box(width, width, boundary), Particles(position.copy(), velocity.copy(), radius=radius),
+        Box(width, width, boundary),
+        Particles(position.copy(), velocity.copy(), radius=radius),
         dt=0.25,
     )
     sim.run(steps=8)

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from collidium import Box, Particles
+from collidium.collisions import StepCollisions, Tally
 from collidium.kernels import reference
-from collidium.kernels.cells import first_overlap, grid_shape, neighbour_table
-from collidium.kernels.stepper import overlapping_pairs, resolve_pairs
+from collidium.kernels.cells import first_overlap, grid_shape
 
 
 def _crowd(rng, n=300, width=10.0):
@@ -22,25 +23,16 @@ def test_overlapping_pairs_resolved_like_the_twin(rng):
     n = len(position)
     velocity = rng.normal(0, 3, (n, 2))
     mass = rng.uniform(0.5, 2, n)
-    ncx, ncy = grid_shape(width, width, 2 * radius.max(), n)
-    cells, shifts = neighbour_table(ncx, ncy, False)
-    work = [np.empty(n, np.int64), np.empty(ncx * ncy, np.int64), np.empty(n, np.int64)]
-    out = np.empty(10 * n, np.int64)
-    count = overlapping_pairs(
-        position, radius, width, width, ncx, ncy, work[0], work[1], work[2],
-        np.empty(n, np.int64), cells, shifts, out,
-    )  # fmt: skip
-    assert count > 20
-    got_velocity = velocity.copy()
-    virial = np.zeros(1)
-    done = resolve_pairs(out[:count], position, got_velocity, mass, width, width, False, virial)
+    particles = Particles(position.copy(), velocity.copy(), mass=mass, radius=radius)
+    tally = Tally()
+    StepCollisions().drift(particles, Box(width, width), 0.0, 0.0, tally)  # no flight: pairs only
     want_velocity = velocity.copy()
     want_done, want_virial = reference.step_collisions(position, want_velocity, mass, radius)
-    assert done == want_done
-    np.testing.assert_allclose(got_velocity, want_velocity, rtol=1e-13, atol=1e-13)
+    assert tally.counts[0] == want_done > 20
+    np.testing.assert_allclose(particles.velocity, want_velocity, rtol=1e-13, atol=1e-13)
     # Repulsive impulses along the line of centres: every term of the virial is positive.
-    assert virial[0] > 0
-    np.testing.assert_allclose(virial[0], want_virial, rtol=1e-12)
+    assert tally.impulse[0] > 0
+    np.testing.assert_allclose(tally.impulse[0], want_virial, rtol=1e-12)
 
 
 def test_first_overlap_equals_twin(rng):

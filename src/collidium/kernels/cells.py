@@ -1,4 +1,4 @@
-"""Uniform cell grid over the box: linked lists of particles per cell, neighbour table, overlaps.
+"""Uniform cell grid over the box: linked lists of particles per cell, neighbour cells, overlaps.
 
 Cells are at least one largest diameter wide, so two disks in contact always sit in the same or
 adjacent cells. Radius-0 particles are in the grid too (the event engine wraps particles through
@@ -11,39 +11,6 @@ import math
 
 import numba
 import numpy as np
-
-
-@numba.njit(cache=True)
-def neighbour_table(ncx: int, ncy: int, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
-    """The 9 cells around each cell (itself included) and the periodic shift to reach each.
-
-    Returns
-    -------
-    cells : ndarray of int64, shape (ncx * ncy, 9)
-        Row ``c`` lists the cells adjacent to cell ``c = cx + ncx * cy``; -1 past a reflecting wall.
-    shifts : ndarray of int64, shape (ncx * ncy, 9, 2)
-        For a periodic box, the whole box lengths to add to a neighbour's position to get the
-        image adjacent to cell ``c``. In a grid of one or two cells the same cell appears under
-        several shifts, so every image within reach is considered.
-    """
-    cells = np.full((ncx * ncy, 9), -1, dtype=np.int64)
-    shifts = np.zeros((ncx * ncy, 9, 2), dtype=np.int64)
-    for cy in range(ncy):
-        for cx in range(ncx):
-            c = cx + ncx * cy
-            k = 0
-            for oy in range(-1, 2):
-                for ox in range(-1, 2):
-                    nx = cx + ox
-                    ny = cy + oy
-                    if periodic:
-                        shifts[c, k, 0] = (nx - nx % ncx) // ncx
-                        shifts[c, k, 1] = (ny - ny % ncy) // ncy
-                        cells[c, k] = nx % ncx + ncx * (ny % ncy)
-                    elif 0 <= nx < ncx and 0 <= ny < ncy:
-                        cells[c, k] = nx + ncx * ny
-                    k += 1
-    return cells, shifts
 
 
 @numba.njit(cache=True, inline="always")

@@ -57,7 +57,6 @@ def coulomb_direct(
     return force, 0.5 * np.sum(k * qq * inv, axis=1), virial
 
 
-
 def coulomb_direct_on(
     position: FloatArray, charge: FloatArray, k: float, softening2: float, targets: IntArray
 ) -> FloatArray:
@@ -70,6 +69,7 @@ def coulomb_direct_on(
         r2[i] = np.inf
         force[row] = k * charge[i] * ((charge / r2**1.5) @ d)
     return force
+
 
 def first_overlap(position: FloatArray, radius: FloatArray) -> tuple[int, int]:
     """The overlapping pair with the smallest (i, j), or (-1, -1); all pairs, reflecting box."""

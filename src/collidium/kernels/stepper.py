@@ -123,7 +123,7 @@ def radius_summary(radius: np.ndarray, copy: np.ndarray) -> tuple[bool, bool, fl
     changed = differs.any()
     if changed:
         copy[:] = radius
-    return changed, not varies.any(), largest.max()
+    return bool(changed), not varies.any(), float(largest.max())
 
 
 @numba.njit(cache=True, parallel=True)
@@ -159,7 +159,8 @@ def sort_into_cells(
     radius : ndarray, shape (N,)
         Radii in m.
     uniform : bool
-        All radii are equal: ``cell_r`` is left alone.
+        All radii are equal: ``cell_r`` is left alone (it holds that radius in every entry, in
+        any order).
     width, height : float
         Box sides in m.
     ncx, ncy : int
@@ -468,7 +469,8 @@ def update_cells(
     fresh_radius : bool
         The radii changed since the step before: read them from ``radius``, not ``cell_r``.
     uniform : bool
-        All radii are equal: ``cell_r`` is left alone.
+        All radii are equal: ``cell_r`` is left alone (it holds that radius in every entry, in
+        any order).
     width, height : float
         Box sides in m.
     ncx, ncy : int
@@ -526,11 +528,19 @@ def update_cells(
     for p in numba.prange(chunks):
         first = _first_mover_at_or_after(sorted_movers, new_key, cell_at[p])
         last = _first_mover_at_or_after(sorted_movers, new_key, cell_at[p + 1])
-        _merge_range(
-            order, key, data_xy, data_r, uniform, new_key, sorted_movers, slot_at[p],
-            slot_at[p + 1], first, last, slot_at[p] - below[p] + first, cell_at[p],
-            cell_at[p + 1], order_out, key_out, start, cell_xy, cell_r,
-        )  # fmt: skip
+        out = slot_at[p] - below[p] + first
+        if uniform:  # a constant argument: numba compiles each case on its own
+            _merge_range(
+                order, key, data_xy, data_r, True, new_key, sorted_movers, slot_at[p],
+                slot_at[p + 1], first, last, out, cell_at[p], cell_at[p + 1], order_out,
+                key_out, start, cell_xy, cell_r,
+            )  # fmt: skip
+        else:
+            _merge_range(
+                order, key, data_xy, data_r, False, new_key, sorted_movers, slot_at[p],
+                slot_at[p + 1], first, last, out, cell_at[p], cell_at[p + 1], order_out,
+                key_out, start, cell_xy, cell_r,
+            )  # fmt: skip
     start[ncells] = n
     return True
 
@@ -538,8 +548,8 @@ def update_cells(
 @numba.njit(cache=True)
 def _scan_shifted(
     a: int, lo: int, hi: int, sx: float, sy: float, width: float, height: float,
-    order: np.ndarray, cell_xy: np.ndarray, cell_r: np.ndarray, uniform: bool, r0: float,
-    found: np.ndarray, base: int, cap: int, count: int,
+    order: np.ndarray, cell_xy: np.ndarray, cell_r: np.ndarray, found: np.ndarray, base: int,
+    cap: int, count: int,
 ) -> int:  # fmt: skip
     """Pairs of slot ``a`` with slots ``lo:hi`` of a cell whose particles are seen shifted by
     ``(sx * width, sy * height)`` (across a periodic edge).
@@ -551,12 +561,12 @@ def _scan_shifted(
     ia = order[a]
     xa = cell_xy[a, 0]
     ya = cell_xy[a, 1]
-    ra = r0 if uniform else cell_r[a]
+    ra = cell_r[a]
     for b in range(lo, hi):
         ib = order[b]
         xb = cell_xy[b, 0]
         yb = cell_xy[b, 1]
-        rb = r0 if uniform else cell_r[b]
+        rb = cell_r[b]
         if ia < ib:
             dx = (xb + sx * width) - xa
             dy = (yb + sy * height) - ya
@@ -574,8 +584,8 @@ def _scan_shifted(
 @numba.njit(cache=True)
 def _search_row(
     cy: int, start: np.ndarray, order: np.ndarray, cell_xy: np.ndarray, cell_r: np.ndarray,
-    uniform: bool, r0: float, ncx: int, ncy: int, width: float, height: float, periodic: bool,
-    found: np.ndarray, base: int, cap: int, count: int,
+    ncx: int, ncy: int, width: float, height: float, periodic: bool, found: np.ndarray,
+    base: int, cap: int, count: int,
 ) -> int:  # fmt: skip
     """Overlapping pairs met from row ``cy``: each cell against itself, its east neighbour and
     the three cells above (a half shell, so each pair of neighbour cells is searched once).
@@ -606,7 +616,7 @@ def _search_row(
             ua = _u(a)
             xa = cell_xy[ua, 0]
             ya = cell_xy[ua, 1]
-            ra = r0 if uniform else cell_r[ua]
+            ra = cell_r[ua]
             if ra <= 0.0:  # points take no part in collisions
                 continue
             # One loop over both runs (fewer mispredicted loop exits than two loops).
@@ -616,7 +626,7 @@ def _search_row(
                 # Computed from a's side whatever the index order: the square is the same.
                 dx = cell_xy[b, 0] - xa
                 dy = cell_xy[b, 1] - ya
-                rb = r0 if uniform else cell_r[b]
+                rb = cell_r[b]
                 sigma = ra + rb
                 if dx * dx + dy * dy < sigma * sigma and rb > 0.0:
                     i = min(order[ua], order[b])
@@ -626,8 +636,8 @@ def _search_row(
                     count += 1
             if edge:
                 count = _search_edges(
-                    a, cx, cy, start, order, cell_xy, cell_r, uniform, r0, ncx, width, height,
-                    up, wrapped_above, found, base, cap, count,
+                    a, cx, cy, start, order, cell_xy, cell_r, ncx, width, height, up,
+                    wrapped_above, found, base, cap, count,
                 )  # fmt: skip
     return count
 
@@ -635,16 +645,16 @@ def _search_row(
 @numba.njit(cache=True)
 def _search_edges(
     a: int, cx: int, cy: int, start: np.ndarray, order: np.ndarray, cell_xy: np.ndarray,
-    cell_r: np.ndarray, uniform: bool, r0: float, ncx: int, width: float, height: float,
-    up: int, wrapped_above: bool, found: np.ndarray, base: int, cap: int, count: int,
+    cell_r: np.ndarray, ncx: int, width: float, height: float, up: int, wrapped_above: bool,
+    found: np.ndarray, base: int, cap: int, count: int,
 ) -> int:  # fmt: skip
     """The half-shell neighbours of slot ``a`` (cell ``cx, cy``) across a periodic edge."""
     sy = 1.0 if wrapped_above else 0.0
     if cx + 1 == ncx:  # east, across the right edge
         row = cy * ncx
         count = _scan_shifted(
-            a, start[row], start[row + 1], 1.0, 0.0, width, height, order, cell_xy, cell_r,
-            uniform, r0, found, base, cap, count,
+            a, start[row], start[row + 1], 1.0, 0.0, width, height, order, cell_xy, cell_r, found,
+            base, cap, count,
         )  # fmt: skip
     for ox in range(-1, 2):
         nx = cx + ox
@@ -658,7 +668,7 @@ def _search_edges(
         if sx != 0.0 or sy != 0.0:
             count = _scan_shifted(
                 a, start[up + nx], start[up + nx + 1], sx, sy, width, height, order, cell_xy,
-                cell_r, uniform, r0, found, base, cap, count,
+                cell_r, found, base, cap, count,
             )  # fmt: skip
     return count
 
@@ -666,8 +676,8 @@ def _search_edges(
 @numba.njit(cache=True)
 def _search_row_general(
     cy: int, start: np.ndarray, order: np.ndarray, cell_xy: np.ndarray, cell_r: np.ndarray,
-    uniform: bool, r0: float, ncx: int, ncy: int, width: float, height: float, periodic: bool,
-    found: np.ndarray, base: int, cap: int, count: int,
+    ncx: int, ncy: int, width: float, height: float, periodic: bool, found: np.ndarray,
+    base: int, cap: int, count: int,
 ) -> int:  # fmt: skip
     """Overlapping pairs ``(i, j)``, j > i, met from each i of row ``cy`` in its 9 neighbour
     cells, under the periodic shift of each (a cell may appear under several shifts)."""
@@ -678,7 +688,7 @@ def _search_row_general(
             i = order[a]
             xi = cell_xy[a, 0]
             yi = cell_xy[a, 1]
-            ri = r0 if uniform else cell_r[a]
+            ri = cell_r[a]
             if ri <= 0.0:
                 continue
             for oy in range(-1, 2):
@@ -694,7 +704,7 @@ def _search_row_general(
                     nc = nx % ncx + ncx * (ny % ncy)
                     for b in range(start[nc], start[nc + 1]):
                         j = order[b]
-                        rj = r0 if uniform else cell_r[b]
+                        rj = cell_r[b]
                         if j > i and rj > 0.0:
                             dx = cell_xy[b, 0] + sx * width - xi
                             dy = cell_xy[b, 1] + sy * height - yi
@@ -712,8 +722,6 @@ def overlapping_pairs(
     order: np.ndarray,
     cell_xy: np.ndarray,
     cell_r: np.ndarray,
-    uniform: bool,
-    r0: float,
     ncx: int,
     ncy: int,
     width: float,
@@ -731,11 +739,7 @@ def overlapping_pairs(
     start, order : ndarray of int
         The particles sorted into cells, as from `sort_into_cells` or `update_cells`.
     cell_xy, cell_r : ndarray of float64, shapes (N, 2) and (N,)
-        Their centres and radii in m, in the same order (``cell_r`` unused if ``uniform``).
-    uniform : bool
-        All radii equal ``r0`` (m).
-    r0 : float
-        The radius of all particles when ``uniform``, in m.
+        Their centres and radii in m, in the same order.
     ncx, ncy : int
         Grid shape.
     width, height : float
@@ -758,8 +762,6 @@ def overlapping_pairs(
         The number of overlapping pairs, or ``-need`` if a band found ``need`` pairs, more than
         its share: call again with ``found`` of at least ``chunks * need`` entries.
     """
-    if uniform and r0 <= 0.0:
-        return 0
     cap = found.shape[0] // chunks
     counts = np.zeros(chunks, dtype=np.int64)
     for k in numba.prange(chunks):
@@ -768,13 +770,18 @@ def overlapping_pairs(
         for cy in range(k * ncy // chunks, (k + 1) * ncy // chunks):
             if general:
                 count = _search_row_general(
-                    cy, start, order, cell_xy, cell_r, uniform, r0, ncx, ncy, width, height,
-                    periodic, found, base, cap, count,
+                    cy, start, order, cell_xy, cell_r, ncx, ncy, width, height, periodic, found,
+                    base, cap, count,
+                )  # fmt: skip
+            elif periodic:  # a constant argument: numba compiles each case on its own
+                count = _search_row(
+                    cy, start, order, cell_xy, cell_r, ncx, ncy, width, height, True, found,
+                    base, cap, count,
                 )  # fmt: skip
             else:
                 count = _search_row(
-                    cy, start, order, cell_xy, cell_r, uniform, r0, ncx, ncy, width, height,
-                    periodic, found, base, cap, count,
+                    cy, start, order, cell_xy, cell_r, ncx, ncy, width, height, False, found,
+                    base, cap, count,
                 )  # fmt: skip
         counts[k] = count
     need = counts.max()
