@@ -7,7 +7,8 @@ and warm-up), so the suite can sweep N from 1e3 to 1e6; where even one step woul
 the function says so (``measured: False``) and gives an estimate instead of running for minutes.
 
 The peers are imported inside the functions, so this module imports without them;
-:func:`available` reports which are installed.
+:func:`available` reports which are installed. Large pymunk runs go to a child Python, since
+freeing a used pymunk space takes minutes at N = 1e6 (see :func:`pymunk_balls`).
 
 Workloads
 ---------
@@ -37,8 +38,8 @@ from typing import Any
 import numpy as np
 
 #: REBOUND tree opening angles giving an RMS relative force error of ~1e-3 (at most ~1.05e-3) on
-#: a uniform square, by N: REBOUND's tree is monopole-only (error ~ theta^2) and at fixed angle
-#: the error grows with N, so matched accuracy needs a smaller angle at larger N. Measured
+#: a uniform square, by N. The error goes as theta^2 (monopole cells; this wheel's tree carries no
+#: quadrupoles) and at fixed angle grows with N, so matched accuracy needs smaller angles. Measured
 #: (seed 1): N = 1e3: 0.13 -> 8.9e-4; 5e3: 0.13 -> 9.7e-4; 2e4: 0.10 -> 9.1e-4 (0.13 -> 1.6e-3);
 #: 1e5: 0.10 -> 1.05e-3, 0.09 -> 8.7e-4 (0.13 -> 1.9e-3).
 REBOUND_THETA_1E3: dict[int, float] = {5_000: 0.13, 20_000: 0.10, 100_000: 0.09}
@@ -229,7 +230,7 @@ def rebound_hard_disks(
 
     REBOUND is 3D: its hard-sphere resolve rotates by ``atan2(dz, dy)``, which for ``dz = 0`` and
     ``dy < 0`` is pi, whose sine is 1.2e-16, not 0. That seeds ``vz`` at round-off, chaos grows it
-    by ~e^5 per unit time and after ~6 time units disks pass over each other (the collision rate
+    by ~e^4 per unit time and after ~7 time units disks pass over each other (the collision rate
     collapses). So every ``flatten_every`` steps ``z`` and ``vz`` are reset to 0 (an O(N) copy,
     counted in the timing; at most a few per cent of a step).
 
@@ -271,10 +272,10 @@ def rebound_hard_disks(
         the default step once relaxed, i.e. roughly the share of collisions a fixed step still
         finds. ``relaxed`` is False when the budget cut the warm-up short of ``warmup_time``
         (N >~ 1e5): the lattice start then has too few disks in contact and the measured rate is
-        low (0.86 of Enskog at N = 1e5 after 0.1 time units, 0.16 at 1e6 after 0.02), so compare
-        ``enskog_collisions_per_second`` instead: the collisions of an equilibrium gas simulated
-        per wall second at the measured stepping speed (a fixed-step tree search costs the same
-        per step whatever the collision count).
+        low (0.86-0.96 of Enskog at N = 1e5 after ~0.1 time units, 0.16-0.19 at 1e6 after 0.02),
+        so compare ``enskog_collisions_per_second`` instead: the collisions of an equilibrium gas
+        simulated per wall second at the measured stepping speed (a fixed-step tree search costs
+        about the same per step whatever the collision count).
     """
     import rebound
 
@@ -676,14 +677,16 @@ def pymunk_balls(
 def _run_isolated(function: str, kwargs: dict[str, Any]) -> dict[str, Any]:
     """``function(**kwargs)`` of this module in a child Python that skips its own teardown.
 
-    The child prints the JSON result as its last line and leaves with ``os._exit(0)``: no
-    destructors, so whatever the workload built is handed back to the OS at once.
+    ``function`` parks what it built in its ``keep_alive`` list, so nothing is freed when it
+    returns; the child prints the JSON result as its last line and leaves with ``os._exit(0)``:
+    no destructors run and the memory goes back to the OS at once.
     """
     code = (
         "import json, os, sys\n"
         f"sys.path.insert(0, {str(Path(__file__).resolve().parent)!r})\n"
         "import peers\n"
-        f"result = peers.{function}(**json.loads(sys.argv[1]))\n"
+        "keep = []\n"
+        f"result = peers.{function}(**json.loads(sys.argv[1]), keep_alive=keep)\n"
         "sys.stdout.write('\\n' + json.dumps(result) + '\\n')\n"
         "sys.stdout.flush()\n"
         "os._exit(0)\n"
@@ -711,8 +714,9 @@ def _pymunk_balls(
     iterations: int,
     threads: int,
     seed: int,
+    keep_alive: list[Any] | None = None,
 ) -> dict[str, Any]:
-    """:func:`pymunk_balls` in this process."""
+    """:func:`pymunk_balls` in this process; the space goes into ``keep_alive`` if given."""
     import pymunk
 
     rng = np.random.default_rng(seed)
@@ -777,6 +781,8 @@ def _pymunk_balls(
             break
     seconds = clock() - start
     steps = done
+    if keep_alive is not None:
+        keep_alive.append((space, objects, bodies))
     return {
         "peer": "pymunk",
         "version": str(pymunk.version),
