@@ -28,7 +28,8 @@ Walk. Each leaf is a group of targets. From the root, a node is accepted when it
 the near field, summed exactly with the softened formula (self skipped, neutral sources skipped
 as in the direct sum). The lists are copied into contiguous columns and each target sums over
 them in a fixed order, in SIMD. Groups run in parallel; each target is summed by one thread by
-the same code, so results are bitwise identical whatever the number of threads.
+the same code, so results are bitwise identical whatever the number of threads. The build (about
+4% of the time) runs on one thread, so a call has a single parallel region.
 
 Accuracy and cost, leaf size 64, for a neutral gas: N charges +1/-1 alternating, uniform in a
 200 m square (N/40000 per m^2), k = 5. Error: RMS relative force error
@@ -36,23 +37,26 @@ Accuracy and cost, leaf size 64, for a neutral gas: N charges +1/-1 alternating,
 median over 8 gases of N = 1e5 (eps = 0; eps = 0.05 gives the same), "worst" the largest over
 N = 1e3, 1e4, 1e5, 1e6, eps = 0 and 0.05, and a 100 times denser gas. This metric is dominated
 by the rare particles whose total force nearly cancels, hence the spread. Time: one evaluation,
-tree build included, N = 1e6, one thread of an AMD Zen 5 (AVX-512), microseconds per particle:
+tree build included, N = 1e6, one thread of an AMD Zen 5 (AVX-512), best of repeated runs on a
+shared machine, microseconds per particle:
 
 =====  =========  =======  ===========
 theta  typical    worst    us/particle
 =====  =========  =======  ===========
-0.2    4.4e-6     3.0e-5   TIME02
-0.25   1.8e-5     9.0e-5   TIME025
-0.3    5.0e-5     3.0e-4   TIME03
-0.35   1.2e-4     3.5e-4   TIME035
-0.4    3.2e-4     2.2e-3   TIME04
-0.5    6.6e-4     3.7e-3   TIME05
+0.2    4.4e-6     3.0e-5   1.96
+0.25   1.8e-5     9.0e-5   1.42
+0.3    5.0e-5     3.0e-4   1.10
+0.35   1.2e-4     3.5e-4   0.91
+0.4    3.2e-4     2.2e-3   0.77
+0.5    6.6e-4     3.7e-3   0.53
 =====  =========  =======  ===========
 
 The default THETA = 0.3 keeps the error below 1e-3 with a margin of 3 in the worst case seen
 and 20 typically; with eps larger than the interparticle spacing (forces then collective
-and weak) errors are 5 to 7 times the eps = 0 ones. Two threads take about TIMEDEF us/particle
-at N = 1e6. The tree beats `coulomb_direct` (2 threads) from about N = CROSSOVER.
+and weak) errors are 5 to 7 times the eps = 0 ones. Two threads take 0.31, 0.40 and 0.59
+us/particle at N = 1e4, 1e5 and 1e6 (one thread: 0.58, 0.76, 1.12). The tree beats
+`coulomb_direct` (2 threads) from about N = 200 (0.15 against 0.23 us/particle at N = 500, 0.21
+against 0.85 at N = 2000).
 
 Use: ``buffers = tree_buffers(n)`` once, then ``coulomb_tree(position, charge, k, eps**2, force,
 energy, virial, buffers)`` each step; or the kernels `build_tree` and `evaluate_tree` directly.
@@ -141,14 +145,14 @@ def _bounding_square(position: np.ndarray) -> tuple[float, float, float]:
     return x_lo, y_lo, side
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True)
 def _morton_codes(
     position: np.ndarray, x_lo: float, y_lo: float, side: float, code: np.ndarray
 ) -> None:
     """Z-order code of each particle's cell on the finest (2**BITS per side) grid."""
     cells = 1 << BITS
     scale = cells / side
-    for i in numba.prange(position.shape[0]):
+    for i in range(position.shape[0]):
         ix = min(max(int((position[i, 0] - x_lo) * scale), 0), cells - 1)
         iy = min(max(int((position[i, 1] - y_lo) * scale), 0), cells - 1)
         code[i] = _spread_bits(ix) | (_spread_bits(iy) << 1)
@@ -192,7 +196,7 @@ def _radix_sort(
         order[:] = spare
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True)
 def _gather_sorted(
     position: np.ndarray,
     charge: np.ndarray,
@@ -202,7 +206,7 @@ def _gather_sorted(
     sorted_q: np.ndarray,
 ) -> None:
     """Copy positions and charges into Morton order, one array per component (for SIMD)."""
-    for i in numba.prange(order.shape[0]):
+    for i in range(order.shape[0]):
         j = order[i]
         sorted_x[i] = position[j, 0]
         sorted_y[i] = position[j, 1]
@@ -342,7 +346,7 @@ def _cell_centre(
     return x_lo + (ix + 0.5) * cell, y_lo + (iy + 0.5) * cell, 0.5 * cell
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True)
 def _leaf_moments(
     sorted_x: np.ndarray,
     sorted_y: np.ndarray,
@@ -359,7 +363,7 @@ def _leaf_moments(
 ) -> None:
     """Raw moments ``sum q dx^a dy^b`` (a + b <= 4) of each leaf about its cell centre, its
     radius (largest particle distance from the centre) and its total |q|."""
-    for t in numba.prange(n_leaves):
+    for t in range(n_leaves):
         node = leaves[t]
         start = node_index[node, 0]
         end = node_index[node, 1]
@@ -421,7 +425,7 @@ def _shift_moments(raw_child: np.ndarray, ox: float, oy: float, raw: np.ndarray)
             raw[degree * (degree + 1) // 2 + b] += total
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True)
 def _internal_moments(
     key: np.ndarray,
     x_lo: float,
@@ -436,7 +440,7 @@ def _internal_moments(
     """Moments of internal nodes from their children's, deepest level first (M2M). The radius
     is bounded by ``max(|offset| + child radius)``."""
     for depth in range(depths - 1, -1, -1):
-        for node in numba.prange(depth_start[depth], depth_start[depth + 1]):
+        for node in range(depth_start[depth], depth_start[depth + 1]):
             first = node_index[node, 2]
             if first < 0:
                 continue
@@ -458,7 +462,7 @@ def _internal_moments(
             node_geometry[node, 3] = charge_abs
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True)
 def _coefficients(node_raw: np.ndarray, nodes: int, node_coef: np.ndarray) -> None:
     """Polynomial coefficients of the far field of each node from its raw moments.
 
@@ -473,7 +477,7 @@ def _coefficients(node_raw: np.ndarray, nodes: int, node_coef: np.ndarray) -> No
     ``B_3 = c10 X^3 + c11 X^2 Y + c12 X Y^2 + c13 Y^3 + c14 X^2 + c15 XY + c16 Y^2``;
     ``B_4 = c17 X^4 + c18 X^3 Y + c19 X^2 Y^2 + c20 X Y^3 + c21 Y^4``.
     """
-    for node in numba.prange(nodes):
+    for node in range(nodes):
         m = node_raw[node]
         c = node_coef[node]
         q = m[0]
@@ -744,28 +748,31 @@ def _gather_far(
 
 @numba.njit(cache=True, parallel=True)
 def _evaluate(
+    k: float,
+    softening2: float,
+    theta: float,
+    order: np.ndarray,
     sorted_x: np.ndarray,
     sorted_y: np.ndarray,
     sorted_q: np.ndarray,
-    softening2: float,
-    theta: float,
     node_index: np.ndarray,
     node_geometry: np.ndarray,
     node_coef: np.ndarray,
     leaves: np.ndarray,
     n_leaves: int,
-    field_x: np.ndarray,
-    field_y: np.ndarray,
-    potential: np.ndarray,
-    pair_virial: np.ndarray,
+    force: np.ndarray,
+    energy: np.ndarray,
+    virial: np.ndarray,
 ) -> None:
-    """Field, potential and virial sum (per unit charge, over k) on every particle, in sorted
-    order.
+    """Forces, energies and virials of every particle, written in the caller's order.
 
     Each leaf is one group: its interaction lists are copied into contiguous columns, then each
-    of its targets sums over them, near field then far field. Groups are split into a fixed
+    of its targets sums over them, near field then far field, and gets ``k q_i`` times the sums
+    (exact zeros for a neutral particle, as in the direct sum). Groups are split into a fixed
     number of contiguous chunks run in parallel (with their own growing scratch arrays), so
-    every target is summed by one thread, by the same instructions, in the same order.
+    every target is summed by one thread, by the same instructions, in the same order. This is
+    the only parallel loop of a call: under oversubscribed cores each parallel region can cost a
+    time slice, and the build is cheap enough to run on one thread.
     """
     chunks = min(n_leaves, 256)
     for chunk in numba.prange(chunks):
@@ -798,44 +805,22 @@ def _evaluate(
                 sorted_x, sorted_y, sorted_q, near, n_near, source, source_index
             )
             for i in range(start, end):
+                j = order[i]
+                kq = k * sorted_q[i]
+                if kq == 0.0:
+                    force[j, 0] = 0.0
+                    force[j, 1] = 0.0
+                    energy[j] = 0.0
+                    virial[j] = 0.0
+                    continue
                 x = sorted_x[i]
                 y = sorted_y[i]
                 ex, ey, phi, w = _near_sum(x, y, i, source, source_index, count, softening2)
                 fx, fy, far_phi, far_w = _far_sum(x, y, far_data, n_far, softening2)
-                field_x[i] = ex + fx
-                field_y[i] = ey + fy
-                potential[i] = phi + far_phi
-                pair_virial[i] = w + far_w
-
-
-@numba.njit(cache=True, parallel=True)
-def _scatter(
-    order: np.ndarray,
-    sorted_q: np.ndarray,
-    k: float,
-    field_x: np.ndarray,
-    field_y: np.ndarray,
-    potential: np.ndarray,
-    pair_virial: np.ndarray,
-    force: np.ndarray,
-    energy: np.ndarray,
-    virial: np.ndarray,
-) -> None:
-    """Multiply by ``k q_i`` and write back in the caller's particle order; a neutral particle
-    gets exact zeros, as in the direct sum."""
-    for i in numba.prange(order.shape[0]):
-        j = order[i]
-        kq = k * sorted_q[i]
-        if kq == 0.0:
-            force[j, 0] = 0.0
-            force[j, 1] = 0.0
-            energy[j] = 0.0
-            virial[j] = 0.0
-        else:
-            force[j, 0] = kq * field_x[i]
-            force[j, 1] = kq * field_y[i]
-            energy[j] = 0.5 * kq * potential[i]
-            virial[j] = 0.5 * kq * pair_virial[i]
+                force[j, 0] = kq * (ex + fx)
+                force[j, 1] = kq * (ey + fy)
+                energy[j] = 0.5 * kq * (phi + far_phi)
+                virial[j] = 0.5 * kq * (w + far_w)
 
 
 # --------------------------------------------------------------------------------------------
@@ -932,10 +917,6 @@ def evaluate_tree(
     node_coef: np.ndarray,
     leaves: np.ndarray,
     n_leaves: int,
-    field_x: np.ndarray,
-    field_y: np.ndarray,
-    potential: np.ndarray,
-    pair_virial: np.ndarray,
     force: np.ndarray,
     energy: np.ndarray,
     virial: np.ndarray,
@@ -952,8 +933,6 @@ def evaluate_tree(
         Opening angle (0 opens every node: direct summation).
     order, sorted_x, sorted_y, sorted_q, node_index, node_geometry, node_coef, leaves : ndarray
         As filled by `build_tree`; ``n_leaves`` its second return value.
-    field_x, field_y, potential, pair_virial : ndarray, shape (N,)
-        Work arrays (sorted order).
     force : ndarray, shape (N, 2)
         Output: total force on each particle, N.
     energy : ndarray, shape (N,)
@@ -962,22 +941,13 @@ def evaluate_tree(
         Output: half of ``sum_j r_ij . F_ij`` for each particle, J.
     """
     _evaluate(
-        sorted_x, sorted_y, sorted_q, softening2, theta, node_index, node_geometry, node_coef,
-        leaves, n_leaves, field_x, field_y, potential, pair_virial,
+        k, softening2, theta, order, sorted_x, sorted_y, sorted_q, node_index, node_geometry,
+        node_coef, leaves, n_leaves, force, energy, virial,
     )  # fmt: skip
-    _scatter(order, sorted_q, k, field_x, field_y, potential, pair_virial, force, energy, virial)
 
 
 _INDEX_ARRAYS = ("code", "key", "key_spare", "order", "order_spare")
-_REAL_ARRAYS = (
-    "sorted_x",
-    "sorted_y",
-    "sorted_q",
-    "field_x",
-    "field_y",
-    "potential",
-    "pair_virial",
-)
+_REAL_ARRAYS = ("sorted_x", "sorted_y", "sorted_q")
 
 
 def _node_arrays(capacity: int) -> dict[str, np.ndarray]:
@@ -1001,7 +971,7 @@ def tree_buffers(n: int, leaf_size: int = LEAF_SIZE) -> dict[str, np.ndarray]:
     Returns
     -------
     dict of str to ndarray
-        About ``(12 + 376 / leaf_size) * 8`` bytes per particle (143 bytes for 64).
+        About ``(8 + 376 / leaf_size) * 8`` bytes per particle (111 bytes for 64).
     """
     arrays: dict[str, np.ndarray] = {name: np.empty(n, dtype=np.int64) for name in _INDEX_ARRAYS}
     arrays.update({name: np.empty(n) for name in _REAL_ARRAYS})
@@ -1075,5 +1045,5 @@ def coulomb_tree(
     evaluate_tree(
         k, softening2, theta, b["order"], b["sorted_x"], b["sorted_y"], b["sorted_q"],
         b["node_index"], b["node_geometry"], b["node_coef"], b["leaves"], n_leaves,
-        b["field_x"], b["field_y"], b["potential"], b["pair_virial"], force, energy, virial,
+        force, energy, virial,
     )  # fmt: skip
