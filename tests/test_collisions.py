@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import pytest
 
 import collidium as cd
-from collidium.collisions import ExactCollisions, Tally, make_drift
+from collidium.collisions import ExactCollisions, Tally, _free_flight, make_drift
 
 
 def _engine(sim: cd.Simulation) -> ExactCollisions:
@@ -82,3 +83,61 @@ def test_event_engine_stops_when_time_no_longer_advances():
     particles = cd.Particles([[0.0, 0.0]], [[3.0, 0.0]], radius=0.5)
     with pytest.raises(cd.SimulationError, match="time stopped advancing"):
         make_drift("exact").drift(particles, box, 1e17, 100.0, Tally())
+
+
+def _packed_step_gas(n: int, seed: int, boundary: str = "reflecting") -> cd.Simulation:
+    """Disks of radius 0.25 m at packing fraction 0.3, seed's step mode, dt = 0.02 s."""
+    from collidium.initial import random_positions
+
+    side = float(np.sqrt(n * np.pi * 0.25**2 / 0.3))
+    rng = np.random.default_rng(seed)
+    radius = np.full(n, 0.25)
+    radius[::50] = 0.15  # unequal radii are carried through the cell sort
+    position = random_positions(n, radius, side, side, rng)
+    particles = cd.Particles(position, rng.normal(0, 2, (n, 2)), radius=radius)
+    return cd.Simulation(cd.Box(side, side, boundary), particles, dt=0.02, collisions="step")
+
+
+@pytest.mark.parametrize("boundary", ["reflecting", "periodic"])
+def test_step_mode_does_not_depend_on_threads_or_history(boundary):
+    """The step mode sorts cells and searches pairs in parallel, and keeps the cell order from
+    one step to the next: neither the thread count nor a fresh start of its grid (as after
+    restoring a checkpoint) may change a bit of the result."""
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("needs two threads")
+    before = numba.get_num_threads()
+    runs = []
+    try:
+        for threads, restart in ((1, False), (2, False), (2, True)):
+            numba.set_num_threads(threads)
+            sim = _packed_step_gas(20000, seed=5, boundary=boundary)
+            for _ in range(6):
+                sim.run(steps=2)
+                if restart:
+                    sim._drift = make_drift("step")
+            runs.append(sim)
+    finally:
+        numba.set_num_threads(before)
+    assert runs[0].counters.pair_collisions > 1000
+    for other in runs[1:]:
+        np.testing.assert_array_equal(other.particles.velocity, runs[0].particles.velocity)
+        np.testing.assert_array_equal(other.particles.position, runs[0].particles.position)
+        np.testing.assert_array_equal(other.tally.counts, runs[0].tally.counts)
+        np.testing.assert_array_equal(other.tally.impulse, runs[0].tally.impulse)
+
+
+def test_step_mode_regrids_when_disks_grow():
+    """Cells stay at least a diameter wide: after the radii grow, every overlap is still found."""
+    from collidium.kernels import reference
+
+    sim = _packed_step_gas(400, seed=6)
+    sim.run(steps=2)
+    p = sim.particles
+    p.radius[:] *= 2.5
+    _free_flight(p, sim.container, 0.0, Tally())  # disks now across a wall are folded back first
+    velocity = p.velocity.copy()
+    before = sim.tally.counts[0]
+    sim._drift.drift(p, sim.container, sim.time, 0.0, sim.tally)  # no flight: pairs only
+    done, _ = reference.step_collisions(p.position, velocity, p.mass, p.radius)
+    assert sim.tally.counts[0] - before == done > 50
+    np.testing.assert_allclose(p.velocity, velocity, rtol=1e-13, atol=1e-13)

@@ -192,6 +192,7 @@ class StepCollisions(_Stateless):
         self._key, self._key_out = np.empty(n, index), np.empty(n, index)
         self._new_key = np.empty(n, dtype=index)
         self._movers = np.empty(n, dtype=index)
+        self._grouped = np.empty(n, dtype=index)
         self._moved = np.empty(stepper.chunk_count(n), dtype=np.int64)
         self._data_xy, self._cell_xy = np.empty((n, 2)), np.empty((n, 2))
         self._data_r, self._cell_r = np.empty(n), np.empty(n)
@@ -205,8 +206,8 @@ class StepCollisions(_Stateless):
             self._sorted = stepper.update_cells(
                 particles.position, particles.radius, fresh, uniform, box.width, box.height,
                 *self._shape, self._order, self._key, self._data_xy, self._data_r,
-                self._new_key, self._movers, self._moved, self._order_out, self._key_out,
-                self._start, self._cell_xy, self._cell_r,
+                self._new_key, self._movers, self._grouped, self._moved, self._order_out,
+                self._key_out, self._start, self._cell_xy, self._cell_r,
             )  # fmt: skip
             if self._sorted:
                 self._order, self._order_out = self._order_out, self._order
@@ -245,8 +246,9 @@ class StepCollisions(_Stateless):
         self._sort(particles, box, changed, uniform)
         while True:
             count = stepper.overlapping_pairs(
-                self._start, self._order, self._cell_xy, self._cell_r, *self._shape, box.width,
-                box.height, box.periodic, self._general, self._chunks, self._pairs, self._scratch,
+                self._start, self._order, self._cell_xy, self._cell_r, uniform, largest,
+                *self._shape, box.width, box.height, box.periodic, self._general, self._chunks,
+                self._pairs, self._scratch,
             )  # fmt: skip
             if count >= 0:
                 break

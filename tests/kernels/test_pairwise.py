@@ -1,7 +1,8 @@
-"""Coulomb direct sum: gradient of the potential, Newton's third law, NumPy twin."""
+"""Coulomb direct sum: gradient of the potential, Newton's third law, NumPy twin, threads."""
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import pytest
 
@@ -70,3 +71,37 @@ def test_kernel_equals_numpy_twin(charges, periodic):
     np.testing.assert_allclose(got_force, want[0], rtol=1e-12, atol=1e-13)
     np.testing.assert_allclose(got_energy, want[1], rtol=1e-12, atol=1e-13)
     np.testing.assert_allclose(got_virial, want[2], rtol=1e-12, atol=1e-13)
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_results_do_not_depend_on_the_number_of_threads(rng, periodic):
+    """Each row is summed by one thread, the same way: bit for bit the same with 1 or 2."""
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("needs two threads")
+    n = 1500
+    position = rng.uniform(-50, 50, (n, 2))
+    charge = rng.choice([-1.0, 1.0, 2.0, 0.0], n)
+    size = np.array([100.0, 100.0]) if periodic else None
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        single = _coulomb(position, charge, eps2=0.01, size=size)
+        numba.set_num_threads(2)
+        double = _coulomb(position, charge, eps2=0.01, size=size)
+    finally:
+        numba.set_num_threads(before)
+    for a, b in zip(single, double, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_neutral_particles_feel_and_exert_nothing(rng):
+    position = rng.uniform(-5, 5, (30, 2))
+    charge = rng.choice([-1.0, 1.0], 30)
+    charge[::3] = 0.0
+    position[3] = position[4]  # a neutral particle on top of a charged one: still no force
+    force, energy, virial = _coulomb(position, charge)
+    assert np.all(force[::3] == 0) and np.all(energy[::3] == 0) and np.all(virial[::3] == 0)
+    charged = charge != 0
+    want = _coulomb(position[charged], charge[charged])
+    np.testing.assert_array_equal(force[charged], want[0])
+    np.testing.assert_array_equal(energy[charged], want[1])

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import pytest
 
 from collidium.kernels import reference
 from collidium.kernels.audit import first_invalid
 from collidium.kernels.placement import place_disks
-from collidium.kernels.walls import drift_periodic, drift_reflecting
+from collidium.kernels.walls import DRIFT_CHUNK, drift_periodic, drift_reflecting, fold
 
 
 def test_reflecting_drift_equals_twin(rng):
@@ -72,3 +73,47 @@ def test_audit_equals_twin(rng, periodic):
         want = reference.first_invalid(p, v, radius, half, periodic, 1e-9)
         assert first_invalid(p, v, radius, 5.0, 5.0, periodic, 1e-9) == want
         assert want[0] == index or (periodic and value == [4.97, 0.0])
+
+
+def _fold_in_index_order(position, velocity, radius, mass, half, dt):
+    """The sequential drift: `walls.fold` particle by particle, wall tallies summed in order."""
+    hits, impulse = np.zeros(4, np.int64), np.zeros(4)
+    for i in range(len(position)):
+        for d in range(2):
+            moving_up = velocity[i, d] > 0
+            x = position[i, d] + velocity[i, d] * dt
+            x, v, bounces = fold(x, velocity[i, d], radius[i] - half, half - radius[i])
+            position[i, d], velocity[i, d] = x, v
+            first, other = 2 * d + int(moving_up), 2 * d + 1 - int(moving_up)
+            hits[first] += (bounces + 1) // 2
+            hits[other] += bounces // 2
+            impulse[first] += 2 * mass[i] * abs(v) * ((bounces + 1) // 2)
+            impulse[other] += 2 * mass[i] * abs(v) * (bounces // 2)
+    return hits, impulse
+
+
+def test_parallel_reflecting_drift_is_the_sequential_one_whatever_the_threads(rng):
+    """Chunks drift in parallel up to their first wall hit; the rest is folded in index order,
+    so positions, velocities and the wall tallies are bit for bit those of one sequential pass."""
+    n = 5 * DRIFT_CHUNK + 17
+    radius = rng.uniform(0.0, 0.3, n)
+    position = rng.uniform(-4.5, 4.5, (n, 2))
+    velocity = rng.normal(0.0, 1.0, (n, 2))
+    velocity[rng.random(n) < 0.01] *= 40.0  # a few particles bounce, some several times
+    mass = rng.uniform(0.5, 2.0, n)
+    want_p, want_v = position.copy(), velocity.copy()
+    want = _fold_in_index_order(want_p, want_v, radius, mass, 5.0, 0.7)
+    before = numba.get_num_threads()
+    try:
+        for threads in range(1, min(2, numba.config.NUMBA_NUM_THREADS) + 1):
+            numba.set_num_threads(threads)
+            got_p, got_v = position.copy(), velocity.copy()
+            hits, impulse = np.zeros(4, np.int64), np.zeros(4)
+            drift_reflecting(got_p, got_v, radius, mass, 5.0, 5.0, 0.7, hits, impulse)
+            np.testing.assert_array_equal(got_p, want_p)
+            np.testing.assert_array_equal(got_v, want_v)
+            np.testing.assert_array_equal(hits, want[0])
+            np.testing.assert_array_equal(impulse, want[1])
+    finally:
+        numba.set_num_threads(before)
+    assert want[0].sum() > 50

@@ -2,9 +2,10 @@
 
 Each row i is summed by one thread, always in the same way, so results do not depend on the
 number of threads (bitwise reproducible). The row loops are vectorised: ``fastmath`` lets LLVM
-keep partial sums in vector lanes and fuse multiply-adds, which changes the round-off of a row
-(not its reproducibility) and nothing else (no approximate functions, no assumptions about
-infinities or NaN).
+reassociate (partial sums in vector lanes, ``k q_i`` taken out of the loop) and fuse
+multiply-adds. That changes the round-off of a row (not its reproducibility): ``F_ij = -F_ji``
+holds to round-off, not bit for bit. Nothing else is relaxed (no approximate functions, no
+assumptions about infinities or NaN).
 """
 
 from __future__ import annotations
@@ -14,7 +15,9 @@ import math
 import numba
 import numpy as np
 
-#: Reassociation (partial sums per vector lane) and fused multiply-add, nothing else.
+#: Reassociation (partial sums per vector lane) and fused multiply-add, nothing else. The row
+#: loops also use NumPy's error model (a division by zero gives inf, as in the parallel kernel),
+#: without which a zero-division check in the loop would keep it from being vectorised.
 _FASTMATH = {"reassoc", "contract"}
 
 
@@ -41,7 +44,7 @@ def coulomb_pair(r2: float, kqq: float, softening2: float) -> tuple[float, float
     return f, f * s2
 
 
-@numba.njit(cache=True, fastmath=_FASTMATH)
+@numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def _row(
     lo: int,
     hi: int,
@@ -70,7 +73,7 @@ def _row(
     return fx, fy, u, w
 
 
-@numba.njit(cache=True, fastmath=_FASTMATH)
+@numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def _row_periodic(
     lo: int,
     hi: int,
@@ -162,13 +165,13 @@ def coulomb_direct(
             index[m] = i
             m += 1
     for c in numba.prange(m):
-        kqi = k * q[c]
+        xi, yi, kqi = x[c], y[c], k * q[c]
         if periodic:
-            below = _row_periodic(0, c, x[c], y[c], kqi, x, y, q, softening2, width, height)
-            above = _row_periodic(c + 1, m, x[c], y[c], kqi, x, y, q, softening2, width, height)
+            below = _row_periodic(0, c, xi, yi, kqi, x, y, q, softening2, width, height)
+            above = _row_periodic(c + 1, m, xi, yi, kqi, x, y, q, softening2, width, height)
         else:
-            below = _row(0, c, x[c], y[c], kqi, x, y, q, softening2)
-            above = _row(c + 1, m, x[c], y[c], kqi, x, y, q, softening2)
+            below = _row(0, c, xi, yi, kqi, x, y, q, softening2)
+            above = _row(c + 1, m, xi, yi, kqi, x, y, q, softening2)
         i = index[c]
         force[i, 0] = below[0] + above[0]
         force[i, 1] = below[1] + above[1]

@@ -31,7 +31,9 @@ from collidium.kernels.collision import elastic_response
 _u = numba.uint64
 
 #: Cells per particle the grid aims at (cells are never narrower than the largest diameter).
-CELLS_PER_PARTICLE = 1.0
+#: Measured fastest at packing fraction 0.3 (cells about two diameters wide there): fewer cells
+#: mean fewer particles changing cell and less to sort, more mean fewer pairs to test.
+CELLS_PER_PARTICLE = 0.65
 
 #: Cells are this much wider than the largest diameter, so that round-off in the cell index can
 #: never put two touching disks two cells apart.
@@ -114,12 +116,18 @@ def radius_summary(radius: np.ndarray, copy: np.ndarray) -> tuple[bool, bool, fl
     first = radius[0] if n > 0 else 0.0
     for p in numba.prange(chunks):
         big = 0.0
+        other = False
+        unequal = False
         for i in range(_u(p * n // chunks), _u((p + 1) * n // chunks)):
             r = radius[i]
             big = max(big, r)
-            differs[p] |= r != copy[i]
-            varies[p] |= r != first
+            other |= r != copy[i]
+            unequal |= r != first
+        # Written once per chunk: entries of one cache line written by several threads in a loop
+        # would bounce the line between their caches.
         largest[p] = big
+        differs[p] = other
+        varies[p] = unequal
     changed = differs.any()
     if changed:
         copy[:] = radius
@@ -242,7 +250,7 @@ def sort_into_cells(
     start[ncx * ncy] = n
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")  # no zero-division check on the cell widths
 def _gather_chunk(
     position: np.ndarray,
     radius: np.ndarray,
@@ -352,17 +360,15 @@ def _sort_movers(movers: np.ndarray, new_key: np.ndarray) -> None:
 
 
 @numba.njit(cache=True)
-def _first_mover_at_or_after(movers: np.ndarray, new_key: np.ndarray, cell: int) -> int:
-    """Binary search: the first of the movers (sorted by new cell) bound for ``cell`` or later."""
-    lo = 0
-    hi = movers.shape[0]
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if new_key[_u(movers[mid])] < cell:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
+def _range_of(cell: int, cell_at: np.ndarray, guess: int) -> int:
+    """The merge range ``p`` with ``cell_at[p] <= cell < cell_at[p + 1]``, searched from
+    ``guess`` (a mover's own range, which it has seldom left)."""
+    p = numba.int64(guess)  # signed: a prange index may come unsigned
+    while cell < cell_at[p]:
+        p -= 1
+    while cell >= cell_at[p + 1]:
+        p += 1
+    return int(p)
 
 
 @numba.njit(cache=True)
@@ -446,6 +452,7 @@ def update_cells(
     data_r: np.ndarray,
     new_key: np.ndarray,
     movers: np.ndarray,
+    grouped: np.ndarray,
     moved: np.ndarray,
     order_out: np.ndarray,
     key_out: np.ndarray,
@@ -456,9 +463,10 @@ def update_cells(
     """Sort the particles into cells again, starting from the order of the step before.
 
     Particles move little in one step: the ones still in the same cell keep their order, the
-    few that changed cell are sorted and merged in, in parallel over ranges of cells. Within a
-    cell the order then depends on the history, which the pair search does not see (it sorts
-    the pairs it finds); the result does not depend on the number of threads.
+    few that changed cell are sorted and merged in, in parallel over ranges of cells (each range
+    takes the movers bound for its cells, in slot order, and sorts them by cell). Within a cell
+    the order then depends on the history, which the pair search does not see (it sorts the
+    pairs it finds); the result does not depend on the number of threads.
 
     Parameters
     ----------
@@ -479,7 +487,7 @@ def update_cells(
         Last step's `order_out` and `key_out` (or the output of `sort_into_cells`).
     data_xy, data_r : ndarray of float64, shapes (N, 2) and (N,)
         Work arrays.
-    new_key, movers : ndarray of int, shape (N,)
+    new_key, movers, grouped : ndarray of int, shape (N,)
         Work arrays.
     moved : ndarray of int64, shape (P,)
         Work array, ``P = chunk_count(N)``.
@@ -504,42 +512,62 @@ def update_cells(
         data_xy, data_r, new_key, movers, moved,
     )  # fmt: skip
     chunks = moved.shape[0]
-    count = 0
-    for p in range(chunks):  # the chunks' movers, one after the other (in slot order)
-        lo = p * n // chunks
-        for k in range(moved[p]):
-            movers[count + k] = movers[lo + k]
-        count += moved[p]
-    if count > n // 8:
+    if moved.sum() > n // 8:
         return False
     # Ranges merged in parallel: the slots of whole cells, about n / chunks of them each.
     slot_at = np.empty(chunks + 1, dtype=np.int64)
     cell_at = np.empty(chunks + 1, dtype=np.int64)
-    below = np.empty(chunks + 1, dtype=np.int64)  # movers from slots before slot_at
     for p in range(chunks + 1):
         s = p * n // chunks
         while 0 < s < n and key[s - 1] == key[s]:
             s -= 1
         slot_at[p] = s
         cell_at[p] = 0 if p == 0 else (ncells if p == chunks else key[s])
-        below[p] = np.searchsorted(movers[:count], s)
-    sorted_movers = movers[:count]
-    _sort_movers(sorted_movers, new_key)
+    # The movers grouped by the range they are bound for, in slot order within a group.
+    bound = np.zeros((chunks, chunks), dtype=np.int64)  # [chunk of slots, range]
+    for q in numba.prange(chunks):
+        lo = q * n // chunks
+        for k in range(moved[q]):
+            bound[q, _range_of(new_key[_u(movers[lo + k])], cell_at, q)] += 1
+    group_at = np.empty(chunks + 1, dtype=np.int64)
+    filled = 0
+    for p in range(chunks):
+        group_at[p] = filled
+        for q in range(chunks):
+            count = bound[q, p]
+            bound[q, p] = filled
+            filled += count
+    group_at[chunks] = filled
+    for q in numba.prange(chunks):
+        lo = q * n // chunks
+        for k in range(moved[q]):
+            s = movers[lo + k]
+            p = _range_of(new_key[_u(s)], cell_at, q)
+            grouped[bound[q, p]] = s
+            bound[q, p] += 1
+    # Each range's output starts after the stayers and movers of the cells before it.
+    below = np.zeros(chunks + 1, dtype=np.int64)  # movers from slots before slot_at[p]
+    for p in range(chunks + 1):
+        for q in range(chunks):
+            lo = q * n // chunks
+            if (q + 1) * n // chunks <= slot_at[p]:
+                below[p] += moved[q]
+            elif lo < slot_at[p]:
+                below[p] += np.searchsorted(movers[lo : lo + moved[q]], slot_at[p])
     for p in numba.prange(chunks):
-        first = _first_mover_at_or_after(sorted_movers, new_key, cell_at[p])
-        last = _first_mover_at_or_after(sorted_movers, new_key, cell_at[p + 1])
-        out = slot_at[p] - below[p] + first
+        _sort_movers(grouped[group_at[p] : group_at[p + 1]], new_key)
+        out = slot_at[p] - below[p] + group_at[p]
         if uniform:  # a constant argument: numba compiles each case on its own
             _merge_range(
-                order, key, data_xy, data_r, True, new_key, sorted_movers, slot_at[p],
-                slot_at[p + 1], first, last, out, cell_at[p], cell_at[p + 1], order_out,
-                key_out, start, cell_xy, cell_r,
+                order, key, data_xy, data_r, True, new_key, grouped, slot_at[p],
+                slot_at[p + 1], group_at[p], group_at[p + 1], out, cell_at[p], cell_at[p + 1],
+                order_out, key_out, start, cell_xy, cell_r,
             )  # fmt: skip
         else:
             _merge_range(
-                order, key, data_xy, data_r, False, new_key, sorted_movers, slot_at[p],
-                slot_at[p + 1], first, last, out, cell_at[p], cell_at[p + 1], order_out,
-                key_out, start, cell_xy, cell_r,
+                order, key, data_xy, data_r, False, new_key, grouped, slot_at[p],
+                slot_at[p + 1], group_at[p], group_at[p + 1], out, cell_at[p], cell_at[p + 1],
+                order_out, key_out, start, cell_xy, cell_r,
             )  # fmt: skip
     start[ncells] = n
     return True
@@ -582,63 +610,67 @@ def _scan_shifted(
 
 
 @numba.njit(cache=True)
-def _search_row(
-    cy: int, start: np.ndarray, order: np.ndarray, cell_xy: np.ndarray, cell_r: np.ndarray,
-    ncx: int, ncy: int, width: float, height: float, periodic: bool, found: np.ndarray,
-    base: int, cap: int, count: int,
+def _search_rows(
+    rows: tuple[int, int], start: np.ndarray, order: np.ndarray, cell_xy: np.ndarray,
+    cell_r: np.ndarray, uniform: bool, r0: float, ncx: int, ncy: int, width: float,
+    height: float, periodic: bool, found: np.ndarray, base: int, cap: int,
 ) -> int:  # fmt: skip
-    """Overlapping pairs met from row ``cy``: each cell against itself, its east neighbour and
-    the three cells above (a half shell, so each pair of neighbour cells is searched once).
+    """Overlapping pairs met from rows ``rows[0]:rows[1]``: each cell against itself, its east
+    neighbour and the three cells above (a half shell, so each pair of neighbour cells is
+    searched once). With ``uniform``, every radius is ``r0`` (m) and ``cell_r`` is not read.
 
-    Pairs are written to ``found[base:base + cap]`` from entry ``count`` on (counted even when
-    they do not fit); returns the new count.
+    Pairs are written to ``found[base:base + cap]`` (counted even when they do not fit); returns
+    their number. (Narrowing the neighbours to those within reach of each particle was measured
+    slower: it adds unpredictable branches per particle.)
     """
     n = order.shape[0]
-    row = cy * ncx
-    above = cy + 1
-    wrapped_above = above == ncy  # the row above lies across the periodic edge
-    if wrapped_above:
-        above = 0
-    up = above * ncx
-    has_above = periodic or not wrapped_above
-    for cx in range(ncx):
-        c = row + cx
-        # Unshifted neighbours, in two contiguous runs of slots: the rest of this cell with the
-        # east cell, and the cells above (those across a periodic edge are searched below).
-        east_end = start[_u(c + 2)] if cx + 1 < ncx else start[_u(c + 1)]
-        above_lo = 0
-        above_hi = 0
-        if has_above and not wrapped_above:
-            above_lo = start[_u(up + max(cx - 1, 0))]
-            above_hi = start[_u(up + min(cx + 1, ncx - 1) + 1)]
-        edge = periodic and (cx == 0 or cx + 1 == ncx or wrapped_above)
-        for a in range(start[_u(c)], start[_u(c + 1)]):
-            ua = _u(a)
-            xa = cell_xy[ua, 0]
-            ya = cell_xy[ua, 1]
-            ra = cell_r[ua]
-            if ra <= 0.0:  # points take no part in collisions
-                continue
-            # One loop over both runs (fewer mispredicted loop exits than two loops).
-            skip = above_lo - east_end  # from the end of the first run to the second
-            for k in range(a + 1, east_end + above_hi - above_lo):
-                b = _u(k if k < east_end else k + skip)
-                # Computed from a's side whatever the index order: the square is the same.
-                dx = cell_xy[b, 0] - xa
-                dy = cell_xy[b, 1] - ya
-                rb = cell_r[b]
-                sigma = ra + rb
-                if dx * dx + dy * dy < sigma * sigma and rb > 0.0:
-                    i = min(order[ua], order[b])
-                    j = max(order[ua], order[b])
-                    if count < cap:
-                        found[base + count] = i * n + j
-                    count += 1
-            if edge:
-                count = _search_edges(
-                    a, cx, cy, start, order, cell_xy, cell_r, ncx, width, height, up,
-                    wrapped_above, found, base, cap, count,
-                )  # fmt: skip
+    count = 0
+    for cy in range(rows[0], rows[1]):
+        row = cy * ncx
+        above = cy + 1
+        wrapped_above = above == ncy  # the row above lies across the periodic edge
+        if wrapped_above:
+            above = 0
+        up = above * ncx
+        has_above = periodic or not wrapped_above
+        for cx in range(ncx):
+            c = row + cx
+            # Unshifted neighbours, in two contiguous runs of slots: the rest of this cell with
+            # the east cell, and the cells above (those across a periodic edge: see below).
+            east_end = start[_u(c + 2)] if cx + 1 < ncx else start[_u(c + 1)]
+            above_lo = 0
+            above_hi = 0
+            if has_above and not wrapped_above:
+                above_lo = start[_u(up + max(cx - 1, 0))]
+                above_hi = start[_u(up + min(cx + 1, ncx - 1) + 1)]
+            edge = periodic and (cx == 0 or cx + 1 == ncx or wrapped_above)
+            for a in range(start[_u(c)], start[_u(c + 1)]):
+                ua = _u(a)
+                xa = cell_xy[ua, 0]
+                ya = cell_xy[ua, 1]
+                ra = r0 if uniform else cell_r[ua]
+                if ra <= 0.0:  # points take no part in collisions
+                    continue
+                # One loop over both runs (fewer mispredicted loop exits than two loops).
+                skip = above_lo - east_end  # from the end of the first run to the second
+                for k in range(a + 1, east_end + above_hi - above_lo):
+                    b = _u(k if k < east_end else k + skip)
+                    # Computed from a's side whatever the index order: the square is the same.
+                    dx = cell_xy[b, 0] - xa
+                    dy = cell_xy[b, 1] - ya
+                    rb = r0 if uniform else cell_r[b]
+                    sigma = ra + rb
+                    if dx * dx + dy * dy < sigma * sigma and rb > 0.0:
+                        i = min(order[ua], order[b])
+                        j = max(order[ua], order[b])
+                        if count < cap:
+                            found[base + count] = i * n + j
+                        count += 1
+                if edge:
+                    count = _search_edges(
+                        a, cx, cy, start, order, cell_xy, cell_r, ncx, width, height, up,
+                        wrapped_above, found, base, cap, count,
+                    )  # fmt: skip
     return count
 
 
@@ -722,6 +754,8 @@ def overlapping_pairs(
     order: np.ndarray,
     cell_xy: np.ndarray,
     cell_r: np.ndarray,
+    uniform: bool,
+    r0: float,
     ncx: int,
     ncy: int,
     width: float,
@@ -740,6 +774,10 @@ def overlapping_pairs(
         The particles sorted into cells, as from `sort_into_cells` or `update_cells`.
     cell_xy, cell_r : ndarray of float64, shapes (N, 2) and (N,)
         Their centres and radii in m, in the same order.
+    uniform : bool
+        Every radius is ``r0``, in m (``cell_r`` must hold it too, for the periodic edges).
+    r0 : float
+        The radius when ``uniform``.
     ncx, ncy : int
         Grid shape.
     width, height : float
@@ -766,23 +804,35 @@ def overlapping_pairs(
     counts = np.zeros(chunks, dtype=np.int64)
     for k in numba.prange(chunks):
         base = k * cap
-        count = 0
-        for cy in range(k * ncy // chunks, (k + 1) * ncy // chunks):
-            if general:
+        rows = (k * ncy // chunks, (k + 1) * ncy // chunks)
+        if general:
+            count = 0
+            for cy in range(rows[0], rows[1]):
                 count = _search_row_general(
                     cy, start, order, cell_xy, cell_r, ncx, ncy, width, height, periodic, found,
                     base, cap, count,
                 )  # fmt: skip
-            elif periodic:  # a constant argument: numba compiles each case on its own
-                count = _search_row(
-                    cy, start, order, cell_xy, cell_r, ncx, ncy, width, height, True, found,
-                    base, cap, count,
-                )  # fmt: skip
-            else:
-                count = _search_row(
-                    cy, start, order, cell_xy, cell_r, ncx, ncy, width, height, False, found,
-                    base, cap, count,
-                )  # fmt: skip
+        # Constant flags: numba compiles each case on its own, without tests in the loops.
+        elif periodic and uniform:
+            count = _search_rows(
+                rows, start, order, cell_xy, cell_r, True, r0, ncx, ncy, width, height, True,
+                found, base, cap,
+            )  # fmt: skip
+        elif periodic:
+            count = _search_rows(
+                rows, start, order, cell_xy, cell_r, False, r0, ncx, ncy, width, height, True,
+                found, base, cap,
+            )  # fmt: skip
+        elif uniform:
+            count = _search_rows(
+                rows, start, order, cell_xy, cell_r, True, r0, ncx, ncy, width, height, False,
+                found, base, cap,
+            )  # fmt: skip
+        else:
+            count = _search_rows(
+                rows, start, order, cell_xy, cell_r, False, r0, ncx, ncy, width, height, False,
+                found, base, cap,
+            )  # fmt: skip
         counts[k] = count
     need = counts.max()
     if need > cap:
