@@ -85,6 +85,9 @@ def test_the_widget_front_end_runs_in_chromium_against_the_widget(browser, viewe
     model whose messages go to a real `Widget` and back."""
     import base64
 
+    # Compile the engine's kernels first (a clean clone has no numba cache), so that the page's
+    # wait for frames below measures the widget, not the compiler.
+    preset("gas", n=60).build().run(steps=2)
     shown = Widget(preset("gas", n=60).build())
     replies: list[tuple[dict, list[bytes] | None]] = []
     shown.send = lambda content, buffers=None: replies.append((content, buffers))
