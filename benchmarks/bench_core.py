@@ -192,6 +192,11 @@ def peak_memory(n: int) -> int:
     return int(done.stdout.split()[-1])
 
 
+def _measured(peer_run: dict[str, Any]) -> float | None:
+    """A REBOUND gravity time per particle-step, if it was run (not predicted from a probe)."""
+    return peer_run.get("us_per_particle_step") if peer_run.get("measured") else None
+
+
 def _ratio(ours: float, theirs: float | None) -> str:
     return f"{ours / theirs:,.1f}x" if theirs else ""
 
@@ -225,7 +230,9 @@ def main() -> None:
     out["w1_rebound"] = list(rebound_gas.values())
     for row in w1:
         n = row["n"]
-        theirs = rebound_gas.get(n, {}).get("collisions_per_second")
+        peer_run = rebound_gas.get(n, {})
+        # Only a settled gas (collision rate near Enskog's) gives REBOUND's real rate.
+        theirs = peer_run.get("collisions_per_second") if peer_run.get("relaxed") else None
         peer = f"REBOUND {theirs:,.0f}" if theirs else ("NumPy twin" if n == 1_000 else "")
         ratio = _ratio(row["per_second"], theirs) if theirs else ""
         rows.append(
@@ -275,7 +282,7 @@ def main() -> None:
         n = row["n"]
         if "direct_seconds" in row:
             ours = row["direct_seconds"] / n * 1e6
-            theirs = gravity.get((n, "basic"), {}).get("us_per_particle_step")
+            theirs = _measured(gravity.get((n, "basic"), {}))
             rows.append(
                 (
                     f"W2 direct N={n:,} ({row['threads']} thr)",
@@ -285,7 +292,7 @@ def main() -> None:
                 )
             )
         ours = row["tree_seconds"] / n * 1e6
-        theirs = gravity.get((n, "tree"), {}).get("us_per_particle_step")
+        theirs = _measured(gravity.get((n, "tree"), {}))
         rows.append(
             (
                 f"W2 tree N={n:,} (theta {row['theta']})",
