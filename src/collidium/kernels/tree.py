@@ -70,6 +70,8 @@ import math
 import numba
 import numpy as np
 
+from collidium.kernels.pairwise import coulomb_pair
+
 THETA = 0.3
 """Default opening angle: a node is used as an expansion when its radius is below THETA times its
 distance from the group of targets (see the module docstring for the measured errors)."""
@@ -564,9 +566,8 @@ def _near_sum(
         dx = x - sx[j]
         dy = y - sy[j]
         r2 = dx * dx + dy * dy
-        inv = 0.0 if source_index[j] == target else 1.0 / math.sqrt(r2 + softening2)
-        u = sq[j] * inv
-        f = u * inv * inv
+        itself = source_index[j] == target  # skipped with a zero charge at a harmless distance
+        f, u = coulomb_pair(1.0 if itself else r2, 0.0 if itself else sq[j], softening2)
         ex += f * dx
         ey += f * dy
         phi += u
