@@ -256,14 +256,14 @@ def test_killed_run_resumes_bitwise(tmp_path):
     import collidium as cd
     from collidium.io.trajectory import read_trajectory
 
-    # About 4 s of work with a checkpoint half-way, so frames past it reach the disk (flushed
-    # every second) before the kill.
-    args = ["run", "gas", "--set", "n=600", "--set", "speed=40", "--steps", "8000", "--every",
-            "500"]  # fmt: skip
+    # Seconds of work with a checkpoint half-way, so frames past it reach the disk (flushed
+    # every second, and at each checkpoint) well before the run ends.
+    args = ["run", "gas", "--set", "n=600", "--set", "speed=40", "--steps", "24000", "--every",
+            "1500"]  # fmt: skip
     whole = collidium(*args, "--out", "whole.gsd", "--checkpoint", "whole.ckpt", cwd=tmp_path)
     assert whole.returncode == 0, whole.stderr
     command = [sys.executable, "-m", "collidium", *args, "--out", "part.gsd", "--checkpoint",
-               "part.ckpt", "--checkpoint-every", "4000"]  # fmt: skip
+               "part.ckpt", "--checkpoint-every", "12000"]  # fmt: skip
     process = subprocess.Popen(command, cwd=tmp_path, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 120
 
@@ -283,17 +283,17 @@ def test_killed_run_resumes_bitwise(tmp_path):
     process.wait()
     assert process.returncode == -signal.SIGKILL
     stopped = cd.restore(tmp_path / "part.ckpt").steps
-    assert stopped < 8000
+    assert stopped < 24000
     assert read_trajectory(tmp_path / "part.gsd").step[-1] > stopped
     resumed = collidium("resume", "part.ckpt", "--json", cwd=tmp_path)
     assert resumed.returncode == 0, resumed.stderr
-    assert json.loads(resumed.stdout)["steps"] == 8000
+    assert json.loads(resumed.stdout)["steps"] == 24000
     a, b = cd.restore(tmp_path / "whole.ckpt"), cd.restore(tmp_path / "part.ckpt")
-    assert a.steps == b.steps == 8000
+    assert a.steps == b.steps == 24000
     np.testing.assert_array_equal(a.particles.position, b.particles.position)
     np.testing.assert_array_equal(a.particles.velocity, b.particles.velocity)
     ta, tb = read_trajectory(tmp_path / "whole.gsd"), read_trajectory(tmp_path / "part.gsd")
-    np.testing.assert_array_equal(ta.step, 500 * np.arange(17))
+    np.testing.assert_array_equal(ta.step, 1500 * np.arange(17))
     np.testing.assert_array_equal(ta.step, tb.step)
     np.testing.assert_array_equal(ta.position, tb.position)
     for key in ta.log:
