@@ -199,6 +199,15 @@ def _measured(peer_run: dict[str, Any]) -> float | None:
     return peer_run.get("us_per_particle_step") if peer_run.get("measured") else None
 
 
+def _time_row(
+    label: str, text: str, peer: str, ours: float, theirs: float | None
+) -> tuple[str, str, str, str]:
+    """A table row for a time per particle-step (lower is better) beside a peer's, if run."""
+    if not theirs:
+        return (label, text, "", "")
+    return (label, text, f"{peer} {theirs:,.3g}", _ratio(theirs, ours))
+
+
 def _ratio(ours: float, theirs: float | None) -> str:
     return f"{ours / theirs:,.1f}x" if theirs else ""
 
@@ -292,21 +301,23 @@ def main() -> None:
             ours = row["direct_seconds"] / n * 1e6
             theirs = _measured(gravity.get((n, "basic"), {}))
             rows.append(
-                (
+                _time_row(
                     f"W2 direct N={n:,} ({row['threads']} thr)",
                     f"{ours:,.3g} us/p-step; {row['direct_pairs_per_second']:,.3g} pairs/s",
-                    f"REBOUND basic {theirs:,.3g}" if theirs else "",
-                    _ratio(theirs, ours) if theirs else "",
+                    "REBOUND basic",
+                    ours,
+                    theirs,
                 )
             )
         ours = row["tree_seconds"] / n * 1e6
         theirs = _measured(gravity.get((n, "tree"), {}))
         rows.append(
-            (
+            _time_row(
                 f"W2 tree N={n:,} (theta {row['theta']})",
                 f"{ours:,.3g} us/p-step; err {row['tree_rms_relative_error']:.1e}",
-                f"REBOUND tree {theirs:,.3g}" if theirs else "",
-                _ratio(theirs, ours) if theirs else "",
+                "REBOUND tree",
+                ours,
+                theirs,
             )
         )
 

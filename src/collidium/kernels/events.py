@@ -374,18 +374,23 @@ def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, 
 # --- cells and slots ----------------------------------------------------------------------------
 
 
+@_engine(inline="always")
+def _push_front(k, c, head, next_, prev) -> None:
+    """Put slot k first in cell c's doubly linked list."""
+    first = head[c]
+    next_[k] = first
+    prev[k] = -1
+    if first >= 0:
+        prev[first] = k
+    head[c] = k
+
+
 @_engine()
 def _link_cells(cell_of, head, next_, prev) -> None:
     """Rebuild the per-cell doubly linked lists from ``cell_of``, each in increasing slot order."""
     head[:] = -1
     for k in range(cell_of.shape[0] - 1, -1, -1):
-        c = cell_of[k]
-        first = head[c]
-        next_[k] = first
-        prev[k] = -1
-        if first >= 0:
-            prev[first] = k
-        head[c] = k
+        _push_front(k, cell_of[k], head, next_, prev)
 
 
 @_engine(inline="always")
@@ -397,12 +402,7 @@ def _move_to_cell(k, new, cell_of, head, next_, prev) -> None:
         head[old] = next_[k]
     if next_[k] >= 0:
         prev[next_[k]] = prev[k]
-    first = head[new]
-    next_[k] = first
-    prev[k] = -1
-    if first >= 0:
-        prev[first] = k
-    head[new] = k
+    _push_front(k, new, head, next_, prev)
     cell_of[k] = new
 
 

@@ -93,6 +93,21 @@ def chunk_count(n: int) -> int:
     return max(1, min(64, n // 4096))
 
 
+@numba.njit(cache=True, inline="always")
+def _share_starts(counts: np.ndarray, starts: np.ndarray) -> None:
+    """Turn ``counts[p, b]``, how many of chunk p's items go to bucket b, into where chunk p's
+    share of bucket b begins (buckets in order, chunks in order within a bucket); ``starts``
+    (B + 1,) gets where each bucket begins, and the total."""
+    filled = 0
+    for b in range(counts.shape[1]):
+        starts[b] = filled
+        for p in range(counts.shape[0]):
+            count = counts[p, b]
+            counts[p, b] = filled
+            filled += count
+    starts[counts.shape[1]] = filled
+
+
 @numba.njit(cache=True, parallel=True)
 def radius_summary(radius: np.ndarray, copy: np.ndarray) -> tuple[bool, bool, float]:
     """Compare the radii with ``copy`` (made equal if they differ) and summarise them.
@@ -204,14 +219,7 @@ def sort_into_cells(
             rows[p, row] += 1
     # Where each chunk's share of each row begins: rows in order, chunks in order within a row.
     row_start = np.empty(ncy + 1, dtype=np.int64)
-    filled = 0
-    for row in range(ncy):
-        row_start[row] = filled
-        for p in range(chunks):
-            count = rows[p, row]
-            rows[p, row] = filled
-            filled += count
-    row_start[ncy] = filled
+    _share_starts(rows, row_start)
     for p in numba.prange(chunks):
         for i in range(_u(p * n // chunks), _u((p + 1) * n // chunks)):
             row = order[i]
@@ -530,14 +538,7 @@ def update_cells(
         for k in range(moved[q]):
             bound[q, _range_of(new_key[_u(movers[lo + k])], cell_at, q)] += 1
     group_at = np.empty(chunks + 1, dtype=np.int64)
-    filled = 0
-    for p in range(chunks):
-        group_at[p] = filled
-        for q in range(chunks):
-            count = bound[q, p]
-            bound[q, p] = filled
-            filled += count
-    group_at[chunks] = filled
+    _share_starts(bound, group_at)
     for q in numba.prange(chunks):
         lo = q * n // chunks
         for k in range(moved[q]):

@@ -748,7 +748,7 @@ def _gather_far(
 
 
 @numba.njit(cache=True, parallel=True)
-def _evaluate(
+def evaluate_tree(
     k: float,
     softening2: float,
     theta: float,
@@ -765,7 +765,7 @@ def _evaluate(
     energy: np.ndarray,
     virial: np.ndarray,
 ) -> None:
-    """Forces, energies and virials of every particle, written in the caller's order.
+    """Coulomb forces, per-particle energies and virials from a tree made by `build_tree`.
 
     Each leaf is one group: its interaction lists are copied into contiguous columns, then each
     of its targets sums over them, near field then far field, and gets ``k q_i`` times the sums
@@ -774,6 +774,23 @@ def _evaluate(
     every target is summed by one thread, by the same instructions, in the same order. This is
     the only parallel loop of a call: under oversubscribed cores each parallel region can cost a
     time slice, and the build is cheap enough to run on one thread.
+
+    Parameters
+    ----------
+    k : float
+        Coulomb constant in N m^2 / C^2.
+    softening2 : float
+        Squared softening length in m^2.
+    theta : float
+        Opening angle (0 opens every node: direct summation).
+    order, sorted_x, sorted_y, sorted_q, node_index, node_geometry, node_coef, leaves : ndarray
+        As filled by `build_tree`; ``n_leaves`` its second return value.
+    force : ndarray, shape (N, 2)
+        Output: total force on each particle, N.
+    energy : ndarray, shape (N,)
+        Output: half the pair energy of each particle with all others, J.
+    virial : ndarray, shape (N,)
+        Output: half of ``sum_j r_ij . F_ij`` for each particle, J.
     """
     chunks = min(n_leaves, 256)
     for chunk in numba.prange(chunks):
@@ -902,49 +919,6 @@ def build_tree(
     )
     _coefficients(node_raw, nodes, node_coef)
     return nodes, n_leaves
-
-
-@numba.njit(cache=True)
-def evaluate_tree(
-    k: float,
-    softening2: float,
-    theta: float,
-    order: np.ndarray,
-    sorted_x: np.ndarray,
-    sorted_y: np.ndarray,
-    sorted_q: np.ndarray,
-    node_index: np.ndarray,
-    node_geometry: np.ndarray,
-    node_coef: np.ndarray,
-    leaves: np.ndarray,
-    n_leaves: int,
-    force: np.ndarray,
-    energy: np.ndarray,
-    virial: np.ndarray,
-) -> None:
-    """Coulomb forces, per-particle energies and virials from a tree made by `build_tree`.
-
-    Parameters
-    ----------
-    k : float
-        Coulomb constant in N m^2 / C^2.
-    softening2 : float
-        Squared softening length in m^2.
-    theta : float
-        Opening angle (0 opens every node: direct summation).
-    order, sorted_x, sorted_y, sorted_q, node_index, node_geometry, node_coef, leaves : ndarray
-        As filled by `build_tree`; ``n_leaves`` its second return value.
-    force : ndarray, shape (N, 2)
-        Output: total force on each particle, N.
-    energy : ndarray, shape (N,)
-        Output: half the pair energy of each particle with all others, J.
-    virial : ndarray, shape (N,)
-        Output: half of ``sum_j r_ij . F_ij`` for each particle, J.
-    """
-    _evaluate(
-        k, softening2, theta, order, sorted_x, sorted_y, sorted_q, node_index, node_geometry,
-        node_coef, leaves, n_leaves, force, energy, virial,
-    )  # fmt: skip
 
 
 _INDEX_ARRAYS = ("code", "key", "key_spare", "order", "order_spare")
