@@ -285,7 +285,11 @@ class ExactCollisions:
             "events": np.array([self.events, self.rebuilds], dtype=np.int64)
         }
         if self._state is not None:
-            out |= {f"queue/{name}": array for name, array in self._state.items()}
+            out |= {
+                f"queue/{name}": array
+                for name, array in self._state.items()
+                if name not in _SLOT_VIEWS
+            }
             out["synced_at"] = np.array([self._synced_at])
         return out
 
@@ -294,8 +298,8 @@ class ExactCollisions:
         one of another layout)."""
         self.events, self.rebuilds = (int(x) for x in arrays["events"])
         queue = {k.removeprefix("queue/"): v for k, v in arrays.items() if k.startswith("queue/")}
-        usable = set(queue) == set(_QUEUE_ARRAYS) and "synced_at" in arrays
-        self._state = {name: np.array(queue[name]) for name in _QUEUE_ARRAYS} if usable else None
+        usable = set(queue) == set(_QUEUE_ARRAYS) - set(_SLOT_VIEWS) and "synced_at" in arrays
+        self._state = _restored(queue) if usable else None
         self._synced_at = float(arrays["synced_at"][0]) if usable else 0.0
 
     def _is_current(self, particles: Particles) -> bool:
@@ -313,26 +317,11 @@ class ExactCollisions:
         n = particles.n
         diameter = 2.0 * float(particles.radius.max(initial=0.0))
         ncx, ncy = event_grid_shape(box.width, box.height, diameter, n)
-        index = np.int32
-        s: dict[str, np.ndarray] = {
-            "body": _cache_aligned_rows(n, events.BODY_COLUMNS),
-            "ident": np.empty(n, dtype=index),
-            "geometry": np.array(
-                [0.5 * box.width, 0.5 * box.height, box.width / ncx, box.height / ncy]
-            ),
-            "grid": np.array([ncx, ncy, int(box.periodic)], dtype=np.int64),
-            "cell_of": np.empty(n, dtype=index),
-            "head": np.empty(ncx * ncy, dtype=index),
-            "next": np.empty(n, dtype=index),
-            "prev": np.empty(n, dtype=index),
-            "count": np.empty(n, dtype=index),
-            "event": np.empty((n, events.EVENT_COLUMNS), dtype=index),
-            "keys": np.empty(n),
-            "items": np.empty(n, dtype=index),
-            "where": np.empty(n, dtype=index),
-            "order": np.empty(n, dtype=index),
-            "scratch": np.empty(n),
-        }
+        s = _engine_arrays(n, ncx * ncy)
+        s["geometry"] = np.array(
+            [0.5 * box.width, 0.5 * box.height, box.width / ncx, box.height / ncy]
+        )
+        s["grid"] = np.array([ncx, ncy, int(box.periodic)], dtype=np.int64)
         events.load(
             particles.position, particles.velocity, particles.radius, particles.mass,
             s["body"], s["ident"],
@@ -377,16 +366,63 @@ class ExactCollisions:
         self._synced_at = until
 
 
-def _cache_aligned_rows(n: int, columns: int) -> FloatArray:
-    """An empty (n, columns) float64 array whose rows start on 64-byte cache lines.
+def _cache_aligned_rows(
+    n: int, columns: int, dtype: type = np.float64, first: int = 0
+) -> np.ndarray:
+    """An empty (n, columns) array whose row ``first`` starts on a 64-byte cache line, and so
+    every row after it if the row size divides 64.
 
-    The engine reads a neighbour as one 64-byte row; large arrays come from the allocator 16
-    bytes past a line, and every row would then span two lines.
+    The engine reads a neighbour as one row, and the heap a node's children as one group from
+    index 1 on; large arrays come from the allocator 16 bytes past a line, and a row or group
+    would then span two lines.
     """
-    line = 64 // 8
-    buffer = np.empty(n * columns + line)
-    skip = (-buffer.ctypes.data % 64) // 8
+    itemsize = np.dtype(dtype).itemsize
+    per_line = 64 // itemsize
+    buffer: np.ndarray = np.empty(n * columns + per_line, dtype=dtype)
+    skip = (-(buffer.ctypes.data + first * columns * itemsize) % 64) // itemsize
     return buffer[skip : skip + n * columns].reshape(n, columns)
+
+
+def _engine_arrays(n: int, cells: int) -> dict[str, np.ndarray]:
+    """Empty engine arrays for n particles and a grid of ``cells`` (all but geometry and grid).
+
+    A slot's integers share one 32-byte row of ``event``: ``ident``, ``cell_of``, ``count`` and
+    ``where`` are views of its last columns, so the engine reads a slot in two cache lines (its
+    ``body`` row and this one).
+    """
+    index = np.int32
+    rows = _cache_aligned_rows(n, events.SLOT_COLUMNS, index)
+    views = {name: rows[:, column] for name, column in _SLOT_VIEWS.items()}
+    return {
+        "body": _cache_aligned_rows(n, events.BODY_COLUMNS),
+        "head": np.empty(cells, dtype=index),
+        "next": np.empty(n, dtype=index),
+        "prev": np.empty(n, dtype=index),
+        "event": rows,
+        "keys": _cache_aligned_rows(n, 1, first=1)[:, 0],
+        "items": _cache_aligned_rows(n, 1, index, first=1)[:, 0],
+        "order": np.empty(n, dtype=index),
+        "scratch": np.empty(n),
+    } | views
+
+
+def _restored(saved: dict[str, np.ndarray]) -> dict[str, np.ndarray] | None:
+    """Engine arrays laid out as `_engine_arrays` with the saved values, or None if the saved
+    rows are not of this engine's width."""
+    n, width = saved["event"].shape
+    if width != events.SLOT_COLUMNS:
+        return None
+    arrays = _engine_arrays(n, saved["head"].shape[0])
+    for name, array in arrays.items():
+        if name not in _SLOT_VIEWS:
+            array[...] = saved[name]
+    return arrays | {name: np.array(saved[name]) for name in ("geometry", "grid")}
+
+
+#: The engine's arrays that are views of columns of ``event`` (`_engine_arrays`).
+_SLOT_VIEWS = {
+    "ident": events.IDENT, "cell_of": events.CELL, "count": events.COUNT, "where": events.WHERE,
+}  # fmt: skip
 
 
 #: The engine's arrays in the order `events.rebuild` and `events.run_events` take them.

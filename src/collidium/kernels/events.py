@@ -3,7 +3,7 @@
 Design (Rapaport; Donev, Torquato & Stillinger; Bannerman's DynamO for the memory layout):
 
 - Each particle keeps one next event: a pair contact, a wall contact or a crossing into the next
-  cell of the grid. A 4-ary heap orders particles by that event time.
+  cell of the grid. An 8-ary heap orders particles by that event time.
 - Positions are lazy: a particle's row holds where it was at its own time stamp; at time t it is
   at ``x + v (t - stamp)``.
 - A pair event records the partner's collision count when it was predicted; if the partner has
@@ -47,6 +47,16 @@ BODY_COLUMNS = 8  # one 64-byte row
 #: earliest pair contact found (`predict`).
 CODE, PARTNER_COUNT, CACHED, CACHED_COUNT = range(4)
 EVENT_COLUMNS = 4
+
+#: Columns after the event's in the rows the caller allocates, so that one 32-byte row holds
+#: every integer of a slot (a slot's state is then two cache lines): the arrays ``ident``,
+#: ``cell_of``, ``count`` and ``where`` that the kernels take may be views of these columns.
+IDENT, CELL, COUNT, WHERE = range(EVENT_COLUMNS, EVENT_COLUMNS + 4)
+SLOT_COLUMNS = EVENT_COLUMNS + 4
+
+#: Children per node of the event queue's heap: 8 keys fill one 64-byte line, and the heap is
+#: half as deep as a binary one's third.
+ARITY = 8
 
 #: Event codes below 0: wall w (0 left, 1 right, 2 bottom, 3 top) is ``-1 - w``; a crossing into
 #: the neighbouring cell in direction d (0 -x, 1 +x, 2 -y, 3 +y) is ``-5 - d``.
@@ -118,9 +128,9 @@ def contact_delay(
     return gap / (-b + math.sqrt(disc))
 
 
-# --- the event queue: a 4-ary heap of slots keyed by event time --------------------------------
+# --- the event queue: an ARITY-ary heap of slots keyed by event time ------------------------------
 #
-# The heap compares times only (branch-free minimum of 4 children, several times faster than
+# The heap compares times only (branch-free minimum of the children, several times faster than
 # comparing (time, ident) pairs); equal times are ordered by ident when the next event is taken
 # (`earliest`), so the order of events is still the total order (time, ident).
 
@@ -129,7 +139,7 @@ def contact_delay(
 def _sift_up(slot, key, item, keys, items, where) -> int:
     """Move ``(key, item)`` up from ``slot`` to its place; return where it landed."""
     while slot > 0:
-        parent = (slot - 1) >> 2
+        parent = (slot - 1) // ARITY
         above = keys[parent]
         if above <= key:
             break
@@ -149,12 +159,12 @@ def _sift_down(slot, key, item, keys, items, where) -> None:
     """Move ``(key, item)`` down from ``slot`` to its place."""
     n = keys.shape[0]
     while True:
-        first = 4 * slot + 1
+        first = ARITY * slot + 1
         if first >= n:
             break
         child = first
         least = keys[first]
-        for c in range(first + 1, min(first + 4, n)):
+        for c in range(first + 1, min(first + ARITY, n)):
             if keys[c] < least:
                 child = c
                 least = keys[c]
@@ -191,7 +201,7 @@ def _earliest_tied(keys, items, ident, stack) -> int:
         s = stack[top]
         if ident[items[s]] < ident[best]:
             best = items[s]
-        for c in range(4 * s + 1, min(4 * s + 5, keys.shape[0])):
+        for c in range(ARITY * s + 1, min(ARITY * s + ARITY + 1, keys.shape[0])):
             if keys[c] == keys[0]:
                 stack[top] = c
                 top += 1
@@ -202,7 +212,7 @@ def _earliest_tied(keys, items, ident, stack) -> int:
 def earliest(keys, items, ident, stack) -> int:
     """The slot whose event comes first in the order (time, ident); ``stack`` is a work array
     (N,) int32 for ties."""
-    for c in range(1, min(5, keys.shape[0])):
+    for c in range(1, min(ARITY + 1, keys.shape[0])):
         if keys[c] == keys[0]:
             return _earliest_tied(keys, items, ident, stack)
     return items[0]
@@ -215,7 +225,7 @@ def _heap_build(keys, items, where) -> None:
     for s in range(n):
         items[s] = s
         where[s] = s
-    for s in range((n - 2) // 4, -1, -1):
+    for s in range((n - 2) // ARITY, -1, -1):
         _sift_down(s, keys[s], items[s], keys, items, where)
 
 
