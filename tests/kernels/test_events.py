@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from collidium import Box, Particles, Simulation
-from collidium.kernels import reference
+from collidium.kernels import events, reference
 from collidium.kernels.events import contact_delay
 from conftest import jittered_lattice
 
@@ -16,6 +16,23 @@ def test_contact_delay_head_on():
     assert contact_delay(2.0, 0.0, -4.0, 0.0, 0.5) == pytest.approx(0.375, rel=1e-15)
     assert contact_delay(2.0, 0.0, 4.0, 0.0, 0.5) == np.inf  # separating
     assert contact_delay(2.0, 0.0, 0.0, 4.0, 0.5) == np.inf  # passing by
+
+
+@pytest.mark.parametrize("n", [1, 9, 73, 600])
+def test_queue_takes_events_in_time_then_ident_order(rng, n):
+    """The heap compares times only; among equal times `earliest` must still give the lowest
+    ident, wherever the tied entries sit in the heap."""
+    keys = rng.choice([1.0, 2.0, 3.0], n)  # many ties at every depth
+    ident = rng.permutation(n).astype(np.int32)
+    heap_keys = keys.copy()
+    items, where, stack = (np.empty(n, dtype=np.int32) for _ in range(3))
+    events._heap_build(heap_keys, items, where)
+    taken = []
+    for _ in range(n):
+        k = events.earliest(heap_keys, items, ident, stack)
+        taken.append(k)
+        events.heap_update(k, np.inf, heap_keys, items, where)
+    assert taken == np.lexsort((ident, keys)).tolist()
 
 
 @pytest.mark.parametrize(

@@ -21,7 +21,10 @@ Memory layout. At 1e5 particles and more the engine waits on memory, not arithme
 - Everything a prediction reads of a neighbour is one 64-byte row of ``body``:
   ``x, y, vx, vy, stamp, radius, mass`` (m, m/s, s, m, kg).
 - An event is one int32 code: the partner's slot (>= 0), a wall (`WALL_CODES`) or a cell
-  crossing (`CELL_CODES`); indices are int32.
+  crossing (`CELL_CODES`); indices are int32. The caller keeps all of a slot's integers in one
+  32-byte row (`SLOT_COLUMNS`), so a slot is two cache lines.
+- The heap's children of a node fill one cache line, and the kernels are compiled without
+  numba's reference counting (`_engine`).
 
 All state lives in arrays owned by the caller (`collidium.collisions.ExactCollisions`), so the queue
 survives from one call to the next: with no forces, dt is only a reporting interval.
