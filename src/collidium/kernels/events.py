@@ -57,8 +57,8 @@ EVENT_COLUMNS = 4
 IDENT, CELL, COUNT, WHERE = range(EVENT_COLUMNS, EVENT_COLUMNS + 4)
 SLOT_COLUMNS = EVENT_COLUMNS + 4
 
-#: Children per node of the event queue's heap: 8 keys fill one 64-byte line, and the heap is
-#: half as deep as a binary one's third.
+#: Children per node of the event queue's heap: 8 keys fill one 64-byte line, and the heap is a
+#: third as deep as a binary one.
 ARITY = 8
 
 #: Event codes below 0: wall w (0 left, 1 right, 2 bottom, 3 top) is ``-1 - w``; a crossing into
