@@ -348,8 +348,8 @@ class ExactCollisions:
         until = now + dt
         processed = events.run_events(
             until, s["body"], s["ident"], particles.image, s["geometry"], s["grid"], s["cell_of"],
-            s["head"], s["next"], s["prev"], s["count"], s["event"], s["keys"], s["items"],
-            s["where"], s["order"], s["scratch"], tally.counts, tally.impulse,
+            s["head"], s["next"], s["count"], s["event"], s["keys"], s["items"], s["where"],
+            s["order"], tally.counts, tally.impulse,
             _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
             max(1, self.sort_interval * particles.n),
         )  # fmt: skip
@@ -397,12 +397,10 @@ def _engine_arrays(n: int, cells: int) -> dict[str, np.ndarray]:
         "body": _cache_aligned_rows(n, events.BODY_COLUMNS),
         "head": np.empty(cells, dtype=index),
         "next": np.empty(n, dtype=index),
-        "prev": np.empty(n, dtype=index),
         "event": rows,
         "keys": _cache_aligned_rows(n, 1, first=1)[:, 0],
         "items": _cache_aligned_rows(n, 1, index, first=1)[:, 0],
         "order": np.empty(n, dtype=index),
-        "scratch": np.empty(n),
     } | views
 
 
@@ -427,6 +425,6 @@ _SLOT_VIEWS = {
 
 #: The engine's arrays in the order `events.rebuild` and `events.run_events` take them.
 _QUEUE_ARRAYS = (
-    "body", "ident", "geometry", "grid", "cell_of", "head", "next", "prev", "count", "event",
-    "keys", "items", "where", "order", "scratch",
+    "body", "ident", "geometry", "grid", "cell_of", "head", "next", "count", "event", "keys",
+    "items", "where", "order",
 )  # fmt: skip

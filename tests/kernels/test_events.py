@@ -93,6 +93,53 @@ def test_slot_order_does_not_change_the_outcome(rng, boundary):
     np.testing.assert_array_equal(a.tally.counts, b.tally.counts)
 
 
+def _by_particle(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The engine's state indexed by particle instead of slot: body rows, the particle of each
+    event's partner and kept contact (-1 for none, wall and cell codes kept), event times."""
+    ident = state["ident"]
+    order = np.argsort(ident)
+    partner = {}
+    for column in (events.CODE, events.CACHED):
+        slots = state["event"][order, column]
+        partner[column] = np.where(slots >= 0, ident[np.maximum(slots, 0)], slots)
+    return {
+        "body": state["body"][order],
+        "counts": state["event"][order][:, [events.PARTNER_COUNT, events.CACHED_COUNT]],
+        "code": partner[events.CODE],
+        "cached": partner[events.CACHED],
+        "cell": state["cell_of"][order],
+        "count": state["count"][order],
+        "time": state["keys"][state["where"][order]],
+    }
+
+
+def test_sorting_slots_moves_every_reference_with_its_particle(rng):
+    """`sort_slots` permutes rows in place along cycles: afterwards the slots are in cell order,
+    and every row, partner, cell list and heap entry still belongs to the same particle."""
+    sim = _dense_gas("periodic", rng)
+    sim._drift.sort_interval = 10**9  # never: the slots drift out of cell order
+    sim.run(steps=1)
+    state = sim._drift._state
+    before = _by_particle(state)
+    assert np.any(np.diff(state["cell_of"]) < 0)
+    events.sort_slots(
+        state["body"], state["cell_of"], state["event"], state["head"], state["next"],
+        state["items"], state["where"], state["order"],
+    )  # fmt: skip
+    assert np.all(np.diff(state["cell_of"]) >= 0)
+    after = _by_particle(state)
+    for name in before:
+        np.testing.assert_array_equal(after[name], before[name], err_msg=name)
+    np.testing.assert_array_equal(state["items"][state["where"]], np.arange(sim.particles.n))
+    members = np.full(sim.particles.n, -1)
+    for cell, first in enumerate(state["head"]):
+        k = first
+        while k >= 0:
+            members[k] = cell
+            k = state["next"][k]
+    np.testing.assert_array_equal(members, state["cell_of"])
+
+
 def test_engine_matches_twin_across_cell_crossings(rng):
     """Small fast disks cross cells thousands of times, so the short prediction after a crossing
     (3 new cells and the kept earliest contact) is taken over and over; with few collisions the

@@ -53,7 +53,8 @@ EVENT_COLUMNS = 4
 
 #: Columns after the event's in the rows the caller allocates, so that one 32-byte row holds
 #: every integer of a slot (a slot's state is then two cache lines): the arrays ``ident``,
-#: ``cell_of``, ``count`` and ``where`` that the kernels take may be views of these columns.
+#: ``cell_of``, ``count`` and ``where`` that the kernels take must be views of these columns,
+#: as `sort_slots` moves whole rows.
 IDENT, CELL, COUNT, WHERE = range(EVENT_COLUMNS, EVENT_COLUMNS + 4)
 SLOT_COLUMNS = EVENT_COLUMNS + 4
 
@@ -388,39 +389,37 @@ def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, 
 
 
 @_engine(inline="always")
-def _push_front(k, c, head, next_, prev) -> None:
-    """Put slot k first in cell c's doubly linked list."""
-    first = head[c]
-    next_[k] = first
-    prev[k] = -1
-    if first >= 0:
-        prev[first] = k
+def _push_front(k, c, head, next_) -> None:
+    """Put slot k first in cell c's list."""
+    next_[k] = head[c]
     head[c] = k
 
 
 @_engine()
-def _link_cells(cell_of, head, next_, prev) -> None:
-    """Rebuild the per-cell doubly linked lists from ``cell_of``, each in increasing slot order."""
+def _link_cells(cell_of, head, next_) -> None:
+    """Rebuild the per-cell linked lists from ``cell_of``, each in increasing slot order."""
     head[:] = -1
     for k in range(cell_of.shape[0] - 1, -1, -1):
-        _push_front(k, cell_of[k], head, next_, prev)
+        _push_front(k, cell_of[k], head, next_)
 
 
 @_engine(inline="always")
-def _move_to_cell(k, new, cell_of, head, next_, prev) -> None:
-    old = cell_of[k]
-    if prev[k] >= 0:
-        next_[prev[k]] = next_[k]
+def _move_to_cell(k, new, cell_of, head, next_) -> None:
+    """Take slot k out of its cell's list and put it first in cell ``new``'s. A cell holds a
+    few disks: walking its list is as fast as keeping back links, and takes no memory."""
+    j = head[cell_of[k]]
+    if j == k:
+        head[cell_of[k]] = next_[k]
     else:
-        head[old] = next_[k]
-    if next_[k] >= 0:
-        prev[next_[k]] = prev[k]
-    _push_front(k, new, head, next_, prev)
+        while next_[j] != k:
+            j = next_[j]
+        next_[j] = next_[k]
+    _push_front(k, new, head, next_)
     cell_of[k] = new
 
 
 @_engine(inline="always")
-def _cross_cell(k, direction, body, ident, image, geometry, grid, cell_of, head, next_, prev):
+def _cross_cell(k, direction, body, ident, image, geometry, grid, cell_of, head, next_):
     """Move slot k into the neighbouring cell; wrap it at a periodic edge."""
     ncx = grid[0]
     d = direction // 2
@@ -434,25 +433,21 @@ def _cross_cell(k, direction, body, ident, image, geometry, grid, cell_of, head,
         image[ident[k], d] += step
     cx = at if d == 0 else c % ncx
     cy = at if d == 1 else c // ncx
-    _move_to_cell(k, cx + ncx * cy, cell_of, head, next_, prev)
+    _move_to_cell(k, cx + ncx * cy, cell_of, head, next_)
 
 
 @_engine(inline="always")
-def _permute(array, order, scratch) -> None:
-    """``array[new] = array[order[new]]`` for an int32 array, through a float64 scratch (exact)."""
-    for new in range(array.shape[0]):
-        scratch[new] = array[order[new]]
-    for new in range(array.shape[0]):
-        array[new] = np.int32(scratch[new])
+def _swap_rows(array, a, b) -> None:
+    for column in range(array.shape[1]):
+        array[a, column], array[b, column] = array[b, column], array[a, column]
 
 
 @_engine()
-def sort_slots(body, ident, cell_of, count, event, head, next_, prev, items, where, order,
-               scratch) -> None:  # fmt: skip
+def sort_slots(body, cell_of, event, head, next_, items, where, order) -> None:
     """Renumber the slots in cell order (a counting sort), keeping every reference consistent.
 
-    ``order`` (N,) int32 and ``scratch`` (N,) float64 are work arrays; ``head`` doubles as the
-    counting array and ``prev`` as the inverse permutation before both are rebuilt.
+    ``order`` (N,) int32 is a work array; ``head`` doubles as the counting array and ``next_``
+    as the inverse permutation before both are rebuilt.
     """
     n = body.shape[0]
     head[:] = 0
@@ -467,32 +462,34 @@ def sort_slots(body, ident, cell_of, count, event, head, next_, prev, items, whe
         c = cell_of[k]
         order[head[c]] = k
         head[c] += 1
-    inverse = prev
+    inverse = next_
     for new in range(n):
         inverse[order[new]] = new
-    for column in range(BODY_COLUMNS):
-        for new in range(n):
-            scratch[new] = body[order[new], column]
-        for new in range(n):
-            body[new, column] = scratch[new]
-    for array in (ident, cell_of, count):
-        _permute(array, order, scratch)
-    for column in range(EVENT_COLUMNS):
-        slots = column in (CODE, CACHED)
-        for new in range(n):
-            value = event[order[new], column]
-            scratch[new] = inverse[value] if slots and value >= 0 else value
-        for new in range(n):
-            event[new, column] = np.int32(scratch[new])
+    # Rows move in place along the cycles of the permutation (row ``new`` takes row
+    # ``order[new]``); a placed row's entry of ``order`` is flipped below 0.
+    for first in range(n):
+        at = first
+        while order[at] >= 0:
+            source = order[at]
+            order[at] = -1 - source
+            if source == first:
+                break
+            _swap_rows(body, at, source)
+            _swap_rows(event, at, source)
+            at = source
+    for k in range(n):
+        for column in (CODE, CACHED):
+            if event[k, column] >= 0:
+                event[k, column] = inverse[event[k, column]]
     for s in range(n):
         items[s] = inverse[items[s]]
         where[items[s]] = s
-    _link_cells(cell_of, head, next_, prev)
+    _link_cells(cell_of, head, next_)
 
 
 @_engine()
-def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, prev, count, event, keys,
-            items, where, order, scratch) -> None:  # fmt: skip
+def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event, keys, items,
+            where, order) -> None:  # fmt: skip
     """Start a fresh queue at time ``now`` (s) from positions synchronised at ``now``.
 
     ``body``'s positions, velocities, radii and masses and ``ident`` are filled by the caller (see
@@ -513,8 +510,7 @@ def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, prev, count,
         event[k, CACHED] = -1
         event[k, CACHED_COUNT] = 0
         items[k] = k
-    sort_slots(body, ident, cell_of, count, event, head, next_, prev, items, where, order,
-               scratch)  # fmt: skip
+    sort_slots(body, cell_of, event, head, next_, items, where, order)
     for k in range(n):
         keys[k] = predict(k, now, -1, body, ident, geometry, grid, cell_of, head, next_, count,
                           event)  # fmt: skip
@@ -535,14 +531,12 @@ def run_events(
     cell_of: np.ndarray,
     head: np.ndarray,
     next_: np.ndarray,
-    prev: np.ndarray,
     count: np.ndarray,
     event: np.ndarray,
     keys: np.ndarray,
     items: np.ndarray,
     where: np.ndarray,
     order: np.ndarray,
-    scratch: np.ndarray,
     tally: np.ndarray,
     impulse: np.ndarray,
     acceleration: np.ndarray,
@@ -587,8 +581,7 @@ def run_events(
     since_sort = 0
     while True:
         if since_sort >= sort_every:
-            sort_slots(body, ident, cell_of, count, event, head, next_, prev, items, where,
-                       order, scratch)  # fmt: skip
+            sort_slots(body, cell_of, event, head, next_, items, where, order)
             since_sort = 0
         t = keys[0]
         if t > until:
@@ -620,8 +613,7 @@ def run_events(
         elif code >= CELL_CODES[1]:
             crossed = -5 - code
             _advance(k, t, body)
-            _cross_cell(k, crossed, body, ident, image, geometry, grid, cell_of, head, next_,
-                        prev)  # fmt: skip
+            _cross_cell(k, crossed, body, ident, image, geometry, grid, cell_of, head, next_)
         t_k = predict(k, t, crossed, body, ident, geometry, grid, cell_of, head, next_, count,
                       event)  # fmt: skip
         heap_update(k, t_k, keys, items, where)
