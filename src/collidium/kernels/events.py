@@ -438,6 +438,7 @@ def _cross_cell(k, direction, body, ident, image, geometry, grid, cell_of, head,
 
 @_engine(inline="always")
 def _swap_rows(array, a, b) -> None:
+    """Exchange rows a and b of a 2-d array."""
     for column in range(array.shape[1]):
         array[a, column], array[b, column] = array[b, column], array[a, column]
 
