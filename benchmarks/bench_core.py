@@ -352,9 +352,9 @@ def main() -> None:
         )
     )
 
-    print(f"{'workload':<40}{'collidium':>40}{'peer':>26}{'ratio':>12}")
+    print(f"{'workload':<40} {'collidium':>40} {'peer':>26} {'ratio':>14}")
     for label, ours_text, peer_text, ratio_text in rows:
-        print(f"{label:<40}{ours_text:>40}{peer_text:>26}{ratio_text:>12}")
+        print(f"{label:<40} {ours_text:>40} {peer_text:>26} {ratio_text:>14}")
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "core.json").write_text(json.dumps(out, indent=2, default=float))
 
