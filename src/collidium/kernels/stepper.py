@@ -25,6 +25,7 @@ import numpy as np
 
 from collidium.kernels.cells import grid_shape
 from collidium.kernels.collision import elastic_response
+from collidium.kernels.sorting import radix_sort
 
 #: Cast to an unsigned index. Numba wraps negative indices around; with an unsigned one it need
 #: not check, which makes the random reads of a gather about twice as fast.
@@ -844,39 +845,20 @@ def overlapping_pairs(
         for m in range(counts[k]):
             found[total + m] = found[k * cap + m]
         total += counts[k]
-    _radix_sort(found[:total], scratch[:total], order.shape[0])
+    _sort_pairs(found[:total], scratch[:total], order.shape[0])
     return total
 
 
 @numba.njit(cache=True)
-def _radix_sort(codes: np.ndarray, scratch: np.ndarray, n: int) -> None:
-    """Sort pair codes ``i * n + j`` in place, 11 bits a pass (a comparison sort of random codes
-    mispredicts a branch per comparison)."""
+def _sort_pairs(codes: np.ndarray, scratch: np.ndarray, n: int) -> None:
+    """Sort pair codes ``i * n + j`` in place (a radix sort above a few hundred)."""
     if codes.shape[0] < 256:
         codes.sort()
         return
     bits = 1
     while (1 << bits) < n * n:
         bits += 1
-    count = np.empty(2048, dtype=np.int64)
-    source = codes
-    target = scratch
-    for shift in range(0, bits, 11):
-        count[:] = 0
-        for v in source:
-            count[(v >> shift) & 2047] += 1
-        total = 0
-        for d in range(2048):
-            c = count[d]
-            count[d] = total
-            total += c
-        for v in source:
-            d = (v >> shift) & 2047
-            target[_u(count[d])] = v
-            count[d] += 1
-        source, target = target, source
-    if source is not codes:
-        codes[:] = source
+    radix_sort(codes, scratch, bits, codes[:0], scratch[:0])
 
 
 @numba.njit(cache=True)

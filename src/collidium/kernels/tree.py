@@ -71,6 +71,7 @@ import numba
 import numpy as np
 
 from collidium.kernels.pairwise import coulomb_pair
+from collidium.kernels.sorting import radix_sort
 
 THETA = 0.3
 """Default opening angle: a node is used as an expansion when its radius is below THETA times its
@@ -158,44 +159,6 @@ def _morton_codes(
         ix = min(max(int((position[i, 0] - x_lo) * scale), 0), cells - 1)
         iy = min(max(int((position[i, 1] - y_lo) * scale), 0), cells - 1)
         code[i] = _spread_bits(ix) | (_spread_bits(iy) << 1)
-
-
-@numba.njit(cache=True)
-def _radix_sort(
-    code: np.ndarray, order: np.ndarray, key: np.ndarray, key_spare: np.ndarray, spare: np.ndarray
-) -> None:
-    """Stable LSD radix sort of the particles by Morton code: ``order`` (N,) gets the permutation
-    and ``key`` (N,) the sorted codes. Starting from index order makes ties resolve by index, so
-    the result is unique."""
-    n = code.shape[0]
-    digit_bits = 11
-    buckets = 1 << digit_bits
-    mask = buckets - 1
-    count = np.empty(buckets, dtype=np.int64)
-    src_key, dst_key, src, dst = key, key_spare, order, spare
-    for i in range(n):
-        src[i] = i
-        src_key[i] = code[i]
-    passes = (2 * BITS + digit_bits - 1) // digit_bits
-    for p in range(passes):
-        shift = p * digit_bits
-        count[:] = 0
-        for i in range(n):
-            count[(src_key[i] >> shift) & mask] += 1
-        total = 0
-        for b in range(buckets):
-            c = count[b]
-            count[b] = total
-            total += c
-        for i in range(n):
-            b = (src_key[i] >> shift) & mask
-            dst_key[count[b]] = src_key[i]
-            dst[count[b]] = src[i]
-            count[b] += 1
-        src_key, dst_key, src, dst = dst_key, src_key, dst, src
-    if passes % 2 == 1:
-        key[:] = key_spare
-        order[:] = spare
 
 
 @numba.njit(cache=True)
@@ -904,7 +867,10 @@ def build_tree(
     """
     x_lo, y_lo, side = _bounding_square(position)
     _morton_codes(position, x_lo, y_lo, side, code)
-    _radix_sort(code, order, key, key_spare, order_spare)
+    for i in range(code.shape[0]):  # from index order, so ties resolve by index
+        key[i] = code[i]
+        order[i] = i
+    radix_sort(key, key_spare, 2 * BITS, order, order_spare)
     _gather_sorted(position, charge, order, sorted_x, sorted_y, sorted_q)
     nodes, depths = _split_nodes(key, leaf_size, node_index, depth_start)
     if nodes < 0:
