@@ -8,6 +8,7 @@ import pytest
 
 import collidium as cd
 from collidium.collisions import ExactCollisions, Tally, _free_flight, make_drift
+from collidium.kernels import events
 
 
 def _engine(sim: cd.Simulation) -> ExactCollisions:
@@ -74,6 +75,24 @@ def test_engine_follows_a_radius_change_between_runs():
     sim.particles.radius[:] = 0.4  # contact now 0.2 m sooner
     sim.run(time=0.03)
     assert sim.counters.pair_collisions == 1
+
+
+def test_engine_rows_drop_radius_and_mass_only_while_all_disks_share_them():
+    sim = cd.load("gas", n=200, seed=4).run(steps=5)
+    assert _engine(sim)._state["body"].shape[1] == events.SHARED_BODY_COLUMNS
+    sim.particles.mass[0] = 2.0  # one heavier disk: every row carries its radius and mass again
+    sim.run(steps=5)
+    assert _engine(sim).rebuilds == 2
+    assert _engine(sim)._state["body"].shape[1] == events.BODY_COLUMNS
+
+
+def test_queue_saved_in_an_earlier_layout_is_rebuilt_not_misread():
+    sim = cd.load("gas", n=100, seed=1).run(steps=3)
+    saved = _engine(sim).state()
+    saved["queue/geometry"] = saved["queue/geometry"][:4]  # before the shared radius and mass
+    engine = ExactCollisions()
+    engine.load_state(saved)
+    assert engine._state is None
 
 
 def test_event_engine_stops_when_time_no_longer_advances():

@@ -307,20 +307,23 @@ class ExactCollisions:
         if s is None or s["body"].shape[0] != particles.n:
             return False
         p = particles
-        return bool(
-            events.matches(
-                self._synced_at, s["body"], s["ident"], p.position, p.velocity, p.radius, p.mass
-            )
-        )
+        synced = events.matches(
+            self._synced_at, s["body"], s["ident"], s["geometry"],
+            p.position, p.velocity, p.radius, p.mass,
+        )  # fmt: skip
+        return bool(synced)
 
     def _rebuild(self, particles: Particles, box: Box, now: float) -> dict[str, np.ndarray]:
         n = particles.n
         diameter = 2.0 * float(particles.radius.max(initial=0.0))
         ncx, ncy = event_grid_shape(box.width, box.height, diameter, n)
-        s = _engine_arrays(n, ncx * ncy)
+        shared = _shared_radius_and_mass(particles)
+        columns = events.BODY_COLUMNS if shared is None else events.SHARED_BODY_COLUMNS
+        s = _engine_arrays(n, ncx * ncy, columns)
         s["geometry"] = np.array(
-            [0.5 * box.width, 0.5 * box.height, box.width / ncx, box.height / ncy]
-        )
+            [0.5 * box.width, 0.5 * box.height, box.width / ncx, box.height / ncy,
+             *(shared or (np.nan, np.nan))]
+        )  # fmt: skip
         s["grid"] = np.array([ncx, ncy, int(box.periodic)], dtype=np.int64)
         events.load(
             particles.position, particles.velocity, particles.radius, particles.mass,
@@ -383,8 +386,18 @@ def _cache_aligned_rows(
     return buffer[skip : skip + n * columns].reshape(n, columns)
 
 
-def _engine_arrays(n: int, cells: int) -> dict[str, np.ndarray]:
-    """Empty engine arrays for n particles and a grid of ``cells`` (all but geometry and grid).
+def _shared_radius_and_mass(particles: Particles) -> tuple[float, float] | None:
+    """The one radius (m) and mass (kg) of every particle, or None if they differ: the engine
+    then keeps them in ``geometry`` and its rows are a quarter smaller (`events`)."""
+    radius, mass = particles.radius, particles.mass
+    if particles.n and (radius == radius[0]).all() and (mass == mass[0]).all():
+        return float(radius[0]), float(mass[0])
+    return None
+
+
+def _engine_arrays(n: int, cells: int, columns: int = events.BODY_COLUMNS) -> dict[str, np.ndarray]:
+    """Empty engine arrays for n particles and a grid of ``cells`` (all but geometry and grid),
+    with ``body`` rows of ``columns`` (`events.BODY_COLUMNS` or `events.SHARED_BODY_COLUMNS`).
 
     A slot's integers share one 32-byte row of ``event``: ``ident``, ``cell_of``, ``count`` and
     ``where`` are views of its last columns, so the engine reads a slot in two cache lines (its
@@ -394,7 +407,7 @@ def _engine_arrays(n: int, cells: int) -> dict[str, np.ndarray]:
     rows = _cache_aligned_rows(n, events.SLOT_COLUMNS, index)
     views = {name: rows[:, column] for name, column in _SLOT_VIEWS.items()}
     return {
-        "body": _cache_aligned_rows(n, events.BODY_COLUMNS),
+        "body": _cache_aligned_rows(n, columns),
         "head": np.empty(cells, dtype=index),
         "next": np.empty(n, dtype=index),
         "event": rows,
@@ -406,11 +419,16 @@ def _engine_arrays(n: int, cells: int) -> dict[str, np.ndarray]:
 
 def _restored(saved: dict[str, np.ndarray]) -> dict[str, np.ndarray] | None:
     """Engine arrays laid out as `_engine_arrays` with the saved values, or None if the saved
-    rows are not of this engine's width."""
+    rows or geometry are not of this engine's layout (an earlier version's)."""
     n, width = saved["event"].shape
-    if width != events.SLOT_COLUMNS:
+    columns = saved["body"].shape[1]
+    if (
+        width != events.SLOT_COLUMNS
+        or columns not in (events.BODY_COLUMNS, events.SHARED_BODY_COLUMNS)
+        or saved["geometry"].shape != (events.GEOMETRY_SIZE,)
+    ):
         return None
-    arrays = _engine_arrays(n, saved["head"].shape[0])
+    arrays = _engine_arrays(n, saved["head"].shape[0], columns)
     for name, array in arrays.items():
         if name not in _SLOT_VIEWS:
             array[...] = saved[name]

@@ -35,6 +35,22 @@ def test_resumed_run_is_bitwise_the_uninterrupted_one(tmp_path, preset, collisio
     assert resumed.name == preset and resumed.collisions == collisions
 
 
+def test_resumed_run_of_disks_of_two_masses_is_bitwise_the_uninterrupted_one(tmp_path):
+    """The exact engine's full rows (each disk's own radius and mass) saved mid-run."""
+
+    def mixed() -> cd.Simulation:
+        sim = cd.load("gas")
+        sim.particles.mass[::2] = 3.0
+        return sim
+
+    whole = mixed().run(steps=300)
+    first = mixed().run(steps=170)
+    first.save(tmp_path / "run.ckpt")
+    resumed = cd.restore(tmp_path / "run.ckpt").run(steps=130)
+    assert_same_run(whole, resumed)
+    assert resumed._drift.rebuilds == whole._drift.rebuilds == 1  # the saved queue went on
+
+
 def test_restore_keeps_dt_changes_the_random_generator_and_periodic_images(tmp_path):
     whole = cd.load("gas", **{"box.boundary": "periodic"})
     whole.run(steps=50)
