@@ -262,8 +262,8 @@ def _heap_build(keys, items, where) -> None:
 def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid):
     """Earliest wall contact or cell crossing of a disk at (x, y) in cell c: ``(delay in s,
     code)``. Ties go to the first found: walls before cells, x before y."""
-    hw = geometry[0]
-    hh = geometry[1]
+    hw = geometry[HALF_WIDTH]
+    hh = geometry[HALF_HEIGHT]
     ncx = grid[0]
     periodic = grid[2] != 0
     best = math.inf
@@ -285,7 +285,7 @@ def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid):
         v = vx if d == 0 else vy
         pos = x if d == 0 else y
         half = hw if d == 0 else hh
-        size = geometry[2 + d]
+        size = geometry[CELL_WIDTH + d]
         at = c % ncx if d == 0 else c // ncx
         cells = grid[d]
         if v > 0.0 and (periodic or at < cells - 1):
@@ -307,8 +307,8 @@ def _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry, g
 
     Returns ``(delay in s, partner slot)``, ``(inf, -1)`` if none; ties go to the lowest ident.
     """
-    hw = geometry[0]
-    hh = geometry[1]
+    hw = geometry[HALF_WIDTH]
+    hh = geometry[HALF_HEIGHT]
     ncx = grid[0]
     ncy = grid[1]
     periodic = grid[2] != 0
@@ -353,9 +353,10 @@ def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, 
     come earlier than the kept contact, and any neighbour that changed or arrived since has
     predicted against k itself.
 
-    ``geometry`` is ``[half_width, half_height, cell_width, cell_height]`` in m; ``grid`` is
-    ``[ncx, ncy, periodic]``. Ties go to the first found in a fixed order (walls, cells, then the
-    partner with the lowest ident), so the outcome does not depend on the slot order.
+    ``geometry`` holds the box's half sides, the cell sides and any shared radius and mass
+    (`HALF_WIDTH` to `SHARED_MASS`); ``grid`` is ``[ncx, ncy, periodic]``. Ties go to the first
+    found in a fixed order (walls, cells, then the partner with the lowest ident), so the outcome
+    does not depend on the slot order.
     """
     lag = now - body[k, STAMP]
     vx = body[k, VX]
@@ -451,7 +452,7 @@ def _cross_cell(k, direction, body, ident, image, geometry, grid, cell_of, head,
     cells = grid[d]
     if at == cells or at < 0:  # periodic edge
         at %= cells
-        body[k, d] -= step * 2.0 * geometry[d]
+        body[k, d] -= step * 2.0 * geometry[HALF_WIDTH + d]
         image[ident[k], d] += step
     cx = at if d == 0 else c % ncx
     cy = at if d == 1 else c // ncx
@@ -519,13 +520,13 @@ def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event
     `load`); this sets the stamps, sorts the slots by cell and predicts every event.
     """
     n = body.shape[0]
-    hw = geometry[0]
-    hh = geometry[1]
+    hw = geometry[HALF_WIDTH]
+    hh = geometry[HALF_HEIGHT]
     ncx = grid[0]
     for k in range(n):
         body[k, STAMP] = now
-        cell_of[k] = cell_index(body[k, X], hw, geometry[2], ncx) + ncx * cell_index(
-            body[k, Y], hh, geometry[3], grid[1]
+        cell_of[k] = cell_index(body[k, X], hw, geometry[CELL_WIDTH], ncx) + ncx * cell_index(
+            body[k, Y], hh, geometry[CELL_HEIGHT], grid[1]
         )
         count[k] = 0
         event[k, CODE] = NO_EVENT
@@ -661,8 +662,8 @@ def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
     nx = body[k, X] - body[j, X]
     ny = body[k, Y] - body[j, Y]
     if grid[2] != 0:
-        nx -= 2.0 * geometry[0] * round(nx / (2.0 * geometry[0]))
-        ny -= 2.0 * geometry[1] * round(ny / (2.0 * geometry[1]))
+        nx -= 2.0 * geometry[HALF_WIDTH] * round(nx / (2.0 * geometry[HALF_WIDTH]))
+        ny -= 2.0 * geometry[HALF_HEIGHT] * round(ny / (2.0 * geometry[HALF_HEIGHT]))
     v1x, v1y, v2x, v2y = _pair_response(
         k, j, nx, ny, midpoint - t, body, ident, geometry, acceleration
     )
@@ -682,7 +683,7 @@ def _bounce(k, wall, t, body, ident, geometry, tally, impulse, acceleration, mid
     _advance(k, t, body)
     d = wall // 2
     upper = wall % 2 == 1
-    half = geometry[d]
+    half = geometry[HALF_WIDTH + d]
     # Snap to the contact point so round-off never leaves the disk past the wall.
     r = _radius(k, body, geometry)
     body[k, X + d] = (half - r) if upper else (r - half)
