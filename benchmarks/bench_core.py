@@ -345,8 +345,8 @@ def main() -> None:
     rows.append(
         (
             f"M peak RSS exact run N={big_n:,}",
-            f"{large['VmHWM'] / mib:,.0f} MiB (anon {large['RssAnon'] / mib:,.0f}, "
-            f"files {large['RssFile'] / mib:,.0f})",
+            f"{large['VmHWM'] / 1e6:,.0f} MB = {large['VmHWM'] / mib:,.0f} MiB "
+            f"(anon {large['RssAnon'] / mib:,.0f}, files {large['RssFile'] / mib:,.0f})",
             f"N=1,000: {small['VmHWM'] / mib:,.0f} MiB",
             f"{per_particle:,.0f} B/particle",
         )

@@ -72,7 +72,7 @@ def test_exact_wall_hit_mirrors_the_normal_component():
 def test_engine_follows_a_radius_change_between_runs():
     sim = cd.load("head-on")
     sim.run(time=0.1)  # centres 1 m apart, closing at 10 m/s: contact at t = 0.15 s
-    sim.particles.radius[:] = 0.4  # contact now 0.2 m sooner
+    sim.particles.radius = 0.4  # contact now 0.2 m sooner
     sim.run(time=0.03)
     assert sim.counters.pair_collisions == 1
 
@@ -80,7 +80,9 @@ def test_engine_follows_a_radius_change_between_runs():
 def test_engine_rows_drop_radius_and_mass_only_while_all_disks_share_them():
     sim = cd.load("gas", n=200, seed=4).run(steps=5)
     assert _engine(sim)._state["body"].shape[1] == events.SHARED_BODY_COLUMNS
-    sim.particles.mass[0] = 2.0  # one heavier disk: every row carries its radius and mass again
+    mass = sim.particles.mass.copy()
+    mass[0] = 2.0  # one heavier disk: every row carries its radius and mass again
+    sim.particles.mass = mass
     sim.run(steps=5)
     assert _engine(sim).rebuilds == 2
     assert _engine(sim)._state["body"].shape[1] == events.BODY_COLUMNS

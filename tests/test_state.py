@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import copy
+import pickle
+
 import numpy as np
 import pytest
 
@@ -63,3 +66,41 @@ def test_bad_simulation_settings_name_the_field(kwargs, field):
     with pytest.raises(InputError) as info:
         Simulation(Box(20, 20), Particles(position=[[0.0, 0.0]]), **kwargs)
     assert info.value.field == field
+
+
+def test_a_scalar_property_is_stored_once_and_read_only():
+    p = Particles(np.zeros((1000, 2)), mass=2.0, radius=[0.1] * 1000)
+    assert p.mass.shape == (1000,) and p.mass.strides == (0,)  # one value, 8 bytes
+    assert p.mass.base is not None and p.mass.base.nbytes == 8
+    with pytest.raises(ValueError, match="read-only"):
+        p.mass[0] = 3.0
+    p.radius[0] = 0.2  # given as an array: each particle's own, writable
+    assert p.radius[:2].tolist() == [0.2, 0.1]
+
+
+def test_assigned_properties_are_checked_and_scalars_shared():
+    p = Particles(np.zeros((3, 2)))
+    p.radius = 0.4
+    assert p.radius.strides == (0,) and p.radius.tolist() == [0.4] * 3
+    mass = p.mass.copy()
+    mass[1] = 5.0
+    p.mass = mass
+    assert p.mass.tolist() == [1.0, 5.0, 1.0] and p.mass.flags.writeable
+    for name, value, words in [("mass", [1, -1, 1], "> 0"), ("charge", np.nan, "not finite"),
+                               ("radius", [1, 2], "3 values")]:  # fmt: skip
+        with pytest.raises(InputError) as info:
+            setattr(p, name, value)
+        assert info.value.field == name and words in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "duplicate", [Particles.copy, copy.deepcopy, lambda p: pickle.loads(pickle.dumps(p))]
+)
+def test_copies_keep_shared_values_shared_and_arrays_independent(duplicate):
+    p = Particles([[0.0, 0.0], [1.0, 0.0]], mass=3.0, charge=[1.0, -1.0])
+    q = duplicate(p)
+    assert q.mass.strides == (0,) and q.mass.tolist() == [3.0, 3.0]
+    assert q.charge.flags.writeable and q.charge.tolist() == [1.0, -1.0]
+    q.position[0, 0] = 9.0
+    q.charge[0] = 2.0
+    assert p.position[0, 0] == 0.0 and p.charge[0] == 1.0

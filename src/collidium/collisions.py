@@ -115,10 +115,11 @@ def _refuse_runaway(particles: Particles, box: Box, dt: float) -> None:
     """Stop before an event-driven drift whose event count would be astronomical."""
     if particles.n == 0:
         return
-    components = np.abs(particles.velocity).max(axis=1)
-    fastest = int(np.argmax(components))
-    speed = float(components[fastest])
+    velocity = particles.velocity
+    # Reductions only: an (N, 2) temporary would add 16 bytes per disk to the peak memory.
+    speed = max(float(velocity.max()), -float(velocity.min()))
     if speed * dt > MAX_CROSSINGS_PER_DRIFT * min(box.width, box.height):
+        fastest = int(np.abs(velocity).max(axis=1).argmax())
         raise SimulationError(
             f"particle {fastest} moves at {speed:.3g} m/s, over {MAX_CROSSINGS_PER_DRIFT:.0g} box "
             "sides per step: the state has run away; try a smaller dt or softening"
@@ -352,7 +353,7 @@ class ExactCollisions:
         processed = events.run_events(
             until, s["body"], s["ident"], particles.image, s["geometry"], s["grid"], s["cell_of"],
             s["head"], s["next"], s["count"], s["event"], s["keys"], s["items"], s["where"],
-            s["order"], tally.counts, tally.impulse,
+            tally.counts, tally.impulse,
             _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
             max(1, self.sort_interval * particles.n),
         )  # fmt: skip
@@ -399,9 +400,9 @@ def _engine_arrays(n: int, cells: int, columns: int = events.BODY_COLUMNS) -> di
     """Empty engine arrays for n particles and a grid of ``cells`` (all but geometry and grid),
     with ``body`` rows of ``columns`` (`events.BODY_COLUMNS` or `events.SHARED_BODY_COLUMNS`).
 
-    A slot's integers share one 32-byte row of ``event``: ``ident``, ``cell_of``, ``count`` and
-    ``where`` are views of its last columns, so the engine reads a slot in two cache lines (its
-    ``body`` row and this one).
+    A slot's integers share one 24-byte row of ``event``: ``ident``, ``cell_of``, ``count`` and
+    ``where`` are views of its last columns, so the engine reads a slot in two rows (its ``body``
+    row and this one).
     """
     index = np.int32
     rows = _cache_aligned_rows(n, events.SLOT_COLUMNS, index)
@@ -413,7 +414,6 @@ def _engine_arrays(n: int, cells: int, columns: int = events.BODY_COLUMNS) -> di
         "event": rows,
         "keys": _cache_aligned_rows(n, 1, first=1)[:, 0],
         "items": _cache_aligned_rows(n, 1, index, first=1)[:, 0],
-        "order": np.empty(n, dtype=index),
     } | views
 
 
@@ -444,5 +444,5 @@ _SLOT_VIEWS = {
 #: The engine's arrays in the order `events.rebuild` and `events.run_events` take them.
 _QUEUE_ARRAYS = (
     "body", "ident", "geometry", "grid", "cell_of", "head", "next", "count", "event", "keys",
-    "items", "where", "order",
+    "items", "where",
 )  # fmt: skip

@@ -115,7 +115,7 @@ def random_positions(
             candidates, all_radii, placed, position, lo, cell, ncx, ncy, head, next_
         )
         if placed == m + n:
-            return position[m:].copy()
+            return position[m:].copy() if m else position
     raise InputError(
         field,
         f"too dense: placed only {placed - m} of {n} disks of radius {r_max:g} m in a "

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from collidium.errors import InputError
 from collidium.presets import PRESETS, preset
-from collidium.scenario import Scenario
 from collidium.simulation import Simulation
+
+if TYPE_CHECKING:
+    from collidium.scenario import Scenario
 
 #: Plain names accepted as overrides of a scenario file, and the fields they stand for.
 FILE_ALIASES = {"dt": "run.dt", "time": "run.time", "collisions": "run.collisions", "seed": "seed"}
@@ -31,6 +33,10 @@ def load_scenario(source: str | Path, **overrides: Any) -> Scenario:
     InputError
         Unknown preset or missing file, bad TOML, unknown parameter or field, invalid value.
     """
+    # Imported on first use: pydantic's models take about 9 MB of memory, which a script that
+    # builds its own `Simulation` does not need.
+    from collidium.scenario import Scenario
+
     dotted = {key: value for key, value in overrides.items() if "." in key}
     plain = {key: value for key, value in overrides.items() if "." not in key}
     if isinstance(source, str) and source in PRESETS:

@@ -16,12 +16,14 @@ from __future__ import annotations
 import inspect
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from collidium.errors import InputError
-from collidium.scenario import Scenario
 
-PresetFunction = Callable[..., Scenario]
+if TYPE_CHECKING:
+    from collidium.scenario import Scenario
+
+PresetFunction = Callable[..., "Scenario"]
 Particles = list[dict[str, Any]]
 #: Builds a preset's particle groups: positional parameters are shared settings it needs
 #: (``mass``, ``radius``...), keyword-only ones (with defaults) are the preset's own knobs.
@@ -96,6 +98,8 @@ def _charged(name: str, section: str, description: str) -> Callable[[Builder], B
 
 def _scenario(name: str, values: dict[str, Any]) -> Scenario:
     """Assemble and validate a preset's scenario from all its parameter values."""
+    from collidium.scenario import Scenario  # on first use (`collidium.loading`)
+
     entry = _ENTRIES[name]
     arguments = inspect.signature(entry.build).parameters
     particles = entry.build(**{key: values[key] for key in arguments})

@@ -590,8 +590,8 @@ class Scenario(_Model):
         state = _concatenate(groups)
         offsets = [0, *np.cumsum([len(g.mass) for g in groups]).tolist()]
         particles = Particles(
-            position=state.position, velocity=state.velocity, mass=state.mass,
-            radius=state.radius, charge=state.charge,
+            position=state.position, velocity=state.velocity, mass=uniform_or_each(state.mass),
+            radius=uniform_or_each(state.radius), charge=uniform_or_each(state.charge),
         )  # fmt: skip
         return box, particles, offsets
 

@@ -31,7 +31,7 @@ from collidium.io.checkpoint import read_checkpoint, write_checkpoint
 from collidium.kernels.audit import first_invalid
 from collidium.kernels.cells import first_overlap, grid_shape
 from collidium.observers.base import Observer
-from collidium.state import FloatArray, Particles
+from collidium.state import PROPERTIES, FloatArray, Particles, as_given
 
 WALL_NAMES = ("left", "right", "bottom", "top")
 
@@ -328,11 +328,13 @@ class Simulation:
         The file is replaced atomically.
         """
         p = self.particles
+        # A value all particles share is saved once, and comes back shared.
+        properties = {name: np.asarray(as_given(getattr(p, name))) for name in PROPERTIES}
+        drift = {f"drift/{key}": value for key, value in self._drift.state().items()}
         arrays = {
-            "position": p.position, "velocity": p.velocity, "mass": p.mass,
-            "radius": p.radius, "charge": p.charge, "image": p.image,
+            "position": p.position, "velocity": p.velocity, "image": p.image,
             "tally/counts": self.tally.counts, "tally/impulse": self.tally.impulse,
-        } | {f"drift/{key}": value for key, value in self._drift.state().items()}  # fmt: skip
+        } | properties | drift  # fmt: skip
         box = self.container
         state = {
             "name": self.name,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any, overload
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -12,16 +14,49 @@ IntArray = NDArray[np.int64]
 
 
 def _per_particle(name: str, value: ArrayLike, n: int) -> FloatArray:
-    """Broadcast a scalar or length-N sequence to a fresh (N,) float64 array."""
+    """A length-N sequence as a fresh (N,) float64 array; a scalar as the value all N particles
+    share, stored once (a read-only (N,) view of it: 8 bytes whatever N). Checked finite, and
+    mass > 0, radius >= 0."""
     try:
         array = np.array(value, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise InputError(name, f"not a number or list of numbers ({exc})") from None
     if array.ndim == 0:
-        return np.full(n, float(array))
-    if array.shape != (n,):
+        array = np.broadcast_to(array, (n,))
+    elif array.shape != (n,):
         raise InputError(name, f"expected a scalar or {n} values, got shape {array.shape}")
+    _check_finite(name, array)
+    wrong = {"mass": array <= 0, "radius": array < 0}.get(name)
+    if wrong is not None and wrong.any():
+        i = int(np.flatnonzero(wrong)[0])
+        sign = ">" if name == "mass" else ">="
+        raise InputError(name, f"must be {sign} 0, particle {i} has {float(array[i])!r}")
     return array
+
+
+def _check_finite(name: str, values: FloatArray) -> None:
+    """Refuse NaN or infinity in (N,) or (N, 2) ``values``, naming the first particle."""
+    finite = np.isfinite(values)
+    bad = np.flatnonzero(~(finite.all(axis=1) if values.ndim == 2 else finite))
+    if bad.size:
+        raise InputError(name, f"not finite (NaN or infinity) for particle {int(bad[0])}")
+
+
+class _PerParticle:
+    """A float property of each particle, (N,): validated on assignment (`_per_particle`)."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    @overload
+    def __get__(self, particles: None, owner: type) -> _PerParticle: ...
+    @overload
+    def __get__(self, particles: Particles, owner: type | None = None) -> FloatArray: ...
+    def __get__(self, particles: Particles | None, owner: type | None = None) -> Any:
+        return self if particles is None else particles.__dict__[self.name]
+
+    def __set__(self, particles: Particles, value: ArrayLike) -> None:
+        particles.__dict__[self.name] = _per_particle(self.name, value, particles.n)
 
 
 def _vectors(name: str, value: ArrayLike) -> FloatArray:
@@ -52,6 +87,11 @@ class Particles:
         Radii in m, >= 0. A radius-0 particle takes no part in pair collisions.
     charge : float or array_like, shape (N,)
         Charges in C.
+
+        Each of ``mass``, ``radius`` and ``charge`` is an (N,) array, checked again whenever it is
+        assigned. Given as a scalar, it is the value all particles share, stored once (8 bytes
+        instead of 8 N: a million disks need 24 MB less) and read-only: assign a new scalar
+        (``p.radius = 0.4``) or an array (``p.mass = p.mass.copy()``, then edit it in place).
     image : array_like of int, shape (N, 2), optional
         Periodic image counts: unwrapped position = position + image * (width, height).
 
@@ -64,9 +104,9 @@ class Particles:
 
     position: FloatArray
     velocity: FloatArray
-    mass: FloatArray
-    radius: FloatArray
-    charge: FloatArray
+    mass = _PerParticle()
+    radius = _PerParticle()
+    charge = _PerParticle()
     image: IntArray
 
     def __init__(
@@ -83,26 +123,14 @@ class Particles:
         self.velocity = _vectors("velocity", np.zeros((n, 2)) if velocity is None else velocity)
         if self.velocity.shape != (n, 2):
             raise InputError("velocity", f"expected shape ({n}, 2), got {self.velocity.shape}")
-        self.mass = _per_particle("mass", mass, n)
-        self.radius = _per_particle("radius", radius, n)
-        self.charge = _per_particle("charge", charge, n)
+        _check_finite("position", self.position)
+        _check_finite("velocity", self.velocity)
+        self.mass = mass
+        self.radius = radius
+        self.charge = charge
         self.image = np.zeros((n, 2), dtype=np.int64)
         if image is not None:
             self.image[...] = np.asarray(image, dtype=np.int64).reshape(n, 2)
-        self._check_values()
-
-    def _check_values(self) -> None:
-        for name in ("position", "velocity", "mass", "radius", "charge"):
-            values = getattr(self, name).reshape(self.n, -1 if self.n else 1)
-            bad = np.flatnonzero(~np.isfinite(values).all(axis=1))
-            if bad.size:
-                raise InputError(name, f"not finite (NaN or infinity) for particle {int(bad[0])}")
-        if (self.mass <= 0).any():
-            i = int(np.flatnonzero(self.mass <= 0)[0])
-            raise InputError("mass", f"must be > 0, particle {i} has {self.mass[i]!r}")
-        if (self.radius < 0).any():
-            i = int(np.flatnonzero(self.radius < 0)[0])
-            raise InputError("radius", f"must be >= 0, particle {i} has {self.radius[i]!r}")
 
     @property
     def n(self) -> int:
@@ -113,15 +141,27 @@ class Particles:
         return self.n
 
     def copy(self) -> Particles:
-        """A deep copy (arrays are copied)."""
-        return Particles(
-            position=self.position.copy(),
-            velocity=self.velocity.copy(),
-            mass=self.mass.copy(),
-            radius=self.radius.copy(),
-            charge=self.charge.copy(),
-            image=self.image.copy(),
-        )
+        """A deep copy (arrays are copied; shared values stay shared)."""
+        return Particles(*self.__reduce__()[1])
+
+    def __deepcopy__(self, memo: dict[int, object]) -> Particles:
+        return self.copy()
+
+    def __reduce__(self) -> tuple[type[Particles], tuple[Any, ...]]:
+        # Pickled as given, so that a shared value is not spread over N entries.
+        given = (as_given(getattr(self, name)) for name in PROPERTIES)
+        return Particles, (self.position, self.velocity, *given, self.image)
+
+
+#: The per-particle properties that a scalar gives to all particles (`Particles`).
+PROPERTIES = ("mass", "radius", "charge")
+
+
+def as_given(values: FloatArray) -> float | FloatArray:
+    """A property of `Particles` as it was given: the shared value if it is stored once, else the
+    per-particle array (to copy or save it without spreading a shared value over N entries)."""
+    shared = values.size > 0 and values.strides == (0,)
+    return float(values[0]) if shared else values
 
 
 def uniform_or_each(values: FloatArray) -> float | FloatArray:

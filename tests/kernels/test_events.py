@@ -25,11 +25,11 @@ def test_queue_takes_events_in_time_then_ident_order(rng, n):
     keys = rng.choice([1.0, 2.0, 3.0], n)  # many ties at every depth
     ident = rng.permutation(n).astype(np.int32)
     heap_keys = keys.copy()
-    items, where, stack = (np.empty(n, dtype=np.int32) for _ in range(3))
+    items, where = (np.empty(n, dtype=np.int32) for _ in range(2))
     events._heap_build(heap_keys, items, where)
     taken = []
     for _ in range(n):
-        k = events.earliest(heap_keys, items, ident, stack)
+        k = events.earliest(heap_keys, items, ident)
         taken.append(k)
         events.heap_update(k, np.inf, heap_keys, items, where)
     assert taken == np.lexsort((ident, keys)).tolist()
@@ -95,18 +95,14 @@ def test_slot_order_does_not_change_the_outcome(rng, boundary):
 
 def _by_particle(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """The engine's state indexed by particle instead of slot: body rows, the particle of each
-    event's partner and kept contact (-1 for none, wall and cell codes kept), event times."""
+    event's partner (wall and cell codes kept), event times."""
     ident = state["ident"]
     order = np.argsort(ident)
-    partner = {}
-    for column in (events.CODE, events.CACHED):
-        slots = state["event"][order, column]
-        partner[column] = np.where(slots >= 0, ident[np.maximum(slots, 0)], slots)
+    code = state["event"][order, events.CODE]
     return {
         "body": state["body"][order],
-        "counts": state["event"][order][:, [events.PARTNER_COUNT, events.CACHED_COUNT]],
-        "code": partner[events.CODE],
-        "cached": partner[events.CACHED],
+        "partner_count": state["event"][order, events.PARTNER_COUNT],
+        "code": np.where(code >= 0, ident[np.maximum(code, 0)], code),
         "cell": state["cell_of"][order],
         "count": state["count"][order],
         "time": state["keys"][state["where"][order]],
@@ -150,7 +146,7 @@ def test_sorting_slots_moves_every_reference_with_its_particle(rng):
     assert np.any(np.diff(state["cell_of"]) < 0)
     events.sort_slots(
         state["body"], state["cell_of"], state["event"], state["head"], state["next"],
-        state["items"], state["where"], state["order"],
+        state["items"], state["where"],
     )  # fmt: skip
     assert np.all(np.diff(state["cell_of"]) >= 0)
     after = _by_particle(state)
@@ -167,10 +163,10 @@ def test_sorting_slots_moves_every_reference_with_its_particle(rng):
 
 
 def test_engine_matches_twin_across_cell_crossings(rng):
-    """Small fast disks cross cells thousands of times, so the short prediction after a crossing
-    (3 new cells and the kept earliest contact) is taken over and over; with few collisions the
-    twin must find the same ones. (Reflecting box: in a periodic one the twin, which looks at
-    the 9 nearest images only, misses contacts more than a box side of free flight away.)"""
+    """Small fast disks cross cells thousands of times, each crossing predicting against the
+    new neighbours; with few collisions the twin must find the same ones. (Reflecting box: in a
+    periodic one the twin, which looks at the 9 nearest images only, misses contacts more than a
+    box side of free flight away.)"""
     boundary = "reflecting"
     width = 10.0
     position = jittered_lattice(10, width, 0.001, rng)

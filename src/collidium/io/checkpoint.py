@@ -79,7 +79,7 @@ def describe_checkpoint(path: str | Path) -> dict[str, Any]:
             "format": "checkpoint",
             "bytes": path.stat().st_size,
             "scenario": state["name"],
-            "n": int(arrays["mass"].shape[0]),
+            "n": int(arrays["position"].shape[0]),
             "box": [state["box"]["width"], state["box"]["height"]],
             "boundary": state["box"]["boundary"],
             "collisions": state["collisions"],

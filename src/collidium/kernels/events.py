@@ -19,15 +19,19 @@ Memory layout. At 1e5 particles and more the engine waits on memory, not arithme
   particle (its index in `collidium.state.Particles`) in slot k. Every tie between equal event
   times is broken by ident, never by slot, so the outcome does not depend on the slot order.
 - Everything a prediction reads of a neighbour is one row of ``body``:
-  ``x, y, vx, vy, stamp`` (m, m/s, s) and, when the disks differ, ``radius, mass`` (m, kg) in a
-  64-byte row. When all disks share one radius and one mass, ``geometry`` holds them and the row
-  is 48 bytes (`SHARED_BODY_COLUMNS`): at N = 1e5 the smaller rows give 10 to 15% more collisions
-  per second.
+  ``x, y, vx, vy, stamp`` (m, m/s, s) and, when the disks differ, ``radius, mass`` (m, kg), 56
+  bytes. When all disks share one radius and one mass, ``geometry`` holds them and the row is 40
+  bytes (`SHARED_BODY_COLUMNS`): smaller rows mean more collisions per second at N = 1e5.
 - An event is one int32 code: the partner's slot (>= 0), a wall (`WALL_CODES`) or a cell
   crossing (`CELL_CODES`); indices are int32. The caller keeps all of a slot's integers in one
-  32-byte row (`SLOT_COLUMNS`), so a slot is two cache lines.
+  24-byte row (`SLOT_COLUMNS`), so a slot is two rows.
 - The heap's children of a node fill one cache line, and the kernels are compiled without
   numba's reference counting (`_engine`).
+- Memory: about 90 bytes per disk of one radius and mass at packing 0.3 (``body`` 40, integers
+  24, heap 12, cell lists 14), so a million disks fit in 300 MB with the interpreter and LLVM.
+  That is why a crossing re-predicts against all 9 cells: keeping the earliest contact found
+  before, to search only the 3 new cells, cost 16 bytes per disk for 7% at N = 1e4 and no
+  measurable gain at 1e5.
 
 All state lives in arrays owned by the caller (`collidium.collisions.ExactCollisions`), so the queue
 survives from one call to the next: with no forces, dt is only a reporting interval.
@@ -43,26 +47,24 @@ import numpy as np
 from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import elastic_response
 
-#: Columns of the ``body`` rows; PAIR_TIME is the earliest pair contact found at the last
-#: prediction (s), kept to shorten predictions after cell crossings. RADIUS and MASS exist only in
-#: rows of `BODY_COLUMNS`; rows of `SHARED_BODY_COLUMNS` take them from ``geometry``.
-X, Y, VX, VY, STAMP, PAIR_TIME, RADIUS, MASS = range(8)
-BODY_COLUMNS = 8  # one 64-byte row
-SHARED_BODY_COLUMNS = 6  # 48 bytes: every disk has the radius and mass in ``geometry``
+#: Columns of the ``body`` rows. RADIUS and MASS exist only in rows of `BODY_COLUMNS`; rows of
+#: `SHARED_BODY_COLUMNS` take them from ``geometry``.
+X, Y, VX, VY, STAMP, RADIUS, MASS = range(7)
+BODY_COLUMNS = 7  # 56 bytes
+SHARED_BODY_COLUMNS = 5  # 40 bytes: every disk has the radius and mass in ``geometry``
 
 #: Entries of ``geometry`` (m, and kg for SHARED_MASS): the box's half sides, the cell sides, and
 #: the radius and mass of every disk when the rows have no columns for them (else NaN).
 HALF_WIDTH, HALF_HEIGHT, CELL_WIDTH, CELL_HEIGHT, SHARED_RADIUS, SHARED_MASS = range(6)
 GEOMETRY_SIZE = 6
 
-#: Columns of the ``event`` rows (int32): the next event's code, the partner's collision count
-#: when it was predicted (a later count makes the event stale), and the same two for the
-#: earliest pair contact found (`predict`).
-CODE, PARTNER_COUNT, CACHED, CACHED_COUNT = range(4)
-EVENT_COLUMNS = 4
+#: Columns of the ``event`` rows (int32): the next event's code and the partner's collision count
+#: when it was predicted (a later count makes the event stale).
+CODE, PARTNER_COUNT = range(2)
+EVENT_COLUMNS = 2
 
-#: Columns after the event's in the rows the caller allocates, so that one 32-byte row holds
-#: every integer of a slot (a slot's state is then two cache lines): the arrays ``ident``,
+#: Columns after the event's in the rows the caller allocates, so that one 24-byte row holds
+#: every integer of a slot (a slot's state is then two rows): the arrays ``ident``,
 #: ``cell_of``, ``count`` and ``where`` that the kernels take must be views of these columns,
 #: as `sort_slots` moves whole rows.
 IDENT, CELL, COUNT, WHERE = range(EVENT_COLUMNS, EVENT_COLUMNS + 4)
@@ -215,32 +217,38 @@ def heap_update(k, key, keys, items, where) -> None:
 
 
 @_engine()
-def _earliest_tied(keys, items, ident, stack) -> int:
-    """Among the entries whose time equals the root's, the slot with the lowest ident (a
-    depth-first search through the children of equal time: heap order puts all of them there).
-    ``stack`` (N,) int32 is a work array."""
+def _earliest_tied(keys, items, ident) -> int:
+    """Among the entries whose time equals the root's, the slot with the lowest ident.
+
+    Heap order puts every such entry in a subtree at the root (its ancestors can be neither later
+    nor earlier), so the search goes down level by level through the span of children of the
+    tied entries found on the level above.
+    """
+    n = keys.shape[0]
+    tied = keys[0]
     best = items[0]
-    stack[0] = 0
-    top = 1
-    while top > 0:
-        top -= 1
-        s = stack[top]
-        if ident[items[s]] < ident[best]:
-            best = items[s]
-        for c in range(ARITY * s + 1, min(ARITY * s + ARITY + 1, keys.shape[0])):
-            if keys[c] == keys[0]:
-                stack[top] = c
-                top += 1
+    lo = hi = 0
+    while ARITY * lo + 1 < n:
+        found_lo = found_hi = -1
+        for c in range(ARITY * lo + 1, min(ARITY * hi + ARITY + 1, n)):
+            if keys[c] == tied:
+                if ident[items[c]] < ident[best]:
+                    best = items[c]
+                if found_lo < 0:
+                    found_lo = c
+                found_hi = c
+        if found_lo < 0:
+            break
+        lo, hi = found_lo, found_hi
     return best
 
 
 @_engine(inline="always")
-def earliest(keys, items, ident, stack) -> int:
-    """The slot whose event comes first in the order (time, ident); ``stack`` is a work array
-    (N,) int32 for ties."""
+def earliest(keys, items, ident) -> int:
+    """The slot whose event comes first in the order (time, ident)."""
     for c in range(1, min(ARITY + 1, keys.shape[0])):
         if keys[c] == keys[0]:
-            return _earliest_tied(keys, items, ident, stack)
+            return _earliest_tied(keys, items, ident)
     return items[0]
 
 
@@ -300,10 +308,9 @@ def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid):
 
 
 @_engine(inline="always")
-def _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry, grid, cell_of,
-                head, next_):  # fmt: skip
-    """Earliest contact of slot k, at (x, y) at time ``now``, with the disks in a block of cells
-    around its own: ``rows`` and ``columns`` are ``(first, last)`` offsets from k's cell.
+def _scan_cells(k, now, x, y, vx, vy, r, body, ident, geometry, grid, cell_of, head, next_):
+    """Earliest contact of slot k, at (x, y) at time ``now``, with the disks in the 9 cells
+    around it.
 
     Returns ``(delay in s, partner slot)``, ``(inf, -1)`` if none; ties go to the lowest ident.
     """
@@ -319,8 +326,8 @@ def _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry, g
     best = math.inf
     best_slot = -1
     best_ident = -1
-    for oy in range(rows[0], rows[1] + 1):
-        for ox in range(columns[0], columns[1] + 1):
+    for oy in range(-1, 2):
+        for ox in range(-1, 2):
             cell, sx, sy = neighbour_cell(cx, cy, ox, oy, ncx, ncy, periodic, 2.0 * hw, 2.0 * hh)
             if cell < 0:
                 continue
@@ -343,15 +350,8 @@ def _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry, g
 
 
 @_engine(inline="always")
-def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, count, event):
+def predict(k, now, body, ident, geometry, grid, cell_of, head, next_, count, event):
     """Find slot k's next event after time ``now`` (s), store it, return its time (s).
-
-    The earliest pair contact found is kept too (``body[k, PAIR_TIME]``, ``event[k, CACHED]``):
-    after a cell crossing in direction ``crossed`` (0 -x, 1 +x, 2 -y, 3 +y; -1 for none) only the
-    3 cells newly in reach are searched and compared with it, if its partner has not collided
-    since. That is exact: k's velocity did not change, the neighbours that did not change cannot
-    come earlier than the kept contact, and any neighbour that changed or arrived since has
-    predicted against k itself.
 
     ``geometry`` holds the box's half sides, the cell sides and any shared radius and mass
     (`HALF_WIDTH` to `SHARED_MASS`); ``grid`` is ``[ncx, ncy, periodic]``. Ties go to the first
@@ -364,45 +364,13 @@ def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, 
     x = body[k, X] + vx * lag
     y = body[k, Y] + vy * lag
     r = _radius(k, body, geometry)
-    delay, code = _walls_and_cells(x, y, vx, vy, r, cell_of[k], geometry, grid)
-    when = now + delay
-    pair_time = math.inf
-    pair = -1
+    when, code = _walls_and_cells(x, y, vx, vy, r, cell_of[k], geometry, grid)
+    when += now
     if r > 0.0:
-        rows = (-1, 1)
-        columns = (-1, 1)
-        kept = event[k, CACHED]
-        # The kept contact must still be valid: if its partner collided since, the next
-        # earliest could be anywhere. In a grid under 3 cells wide, periodic neighbours repeat
-        # under several shifts.
-        partial = (
-            crossed >= 0
-            and (kept < 0 or count[kept] == event[k, CACHED_COUNT])
-            and grid[0] >= 3
-            and grid[1] >= 3
-        )
-        if partial:
-            edge = 1 if crossed % 2 == 1 else -1
-            if crossed < 2:
-                columns = (edge, edge)
-            else:
-                rows = (edge, edge)
-        found, pair = _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry,
-                                  grid, cell_of, head, next_)  # fmt: skip
-        pair_time = now + found
-        if partial and kept >= 0:
-            kept_time = body[k, PAIR_TIME]
-            if (
-                pair < 0
-                or kept_time < pair_time
-                or (kept_time == pair_time and ident[kept] < ident[pair])
-            ):
-                pair_time, pair = kept_time, kept
-        if pair >= 0 and pair_time < when:
-            when, code = pair_time, pair
-    body[k, PAIR_TIME] = pair_time
-    event[k, CACHED] = pair
-    event[k, CACHED_COUNT] = count[pair] if pair >= 0 else 0
+        found, pair = _scan_cells(k, now, x, y, vx, vy, r, body, ident, geometry, grid, cell_of,
+                                  head, next_)  # fmt: skip
+        if pair >= 0 and now + found < when:
+            when, code = now + found, pair
     event[k, CODE] = code
     event[k, PARTNER_COUNT] = count[code] if code >= 0 else 0
     return when
@@ -467,11 +435,11 @@ def _swap_rows(array, a, b) -> None:
 
 
 @_engine()
-def sort_slots(body, cell_of, event, head, next_, items, where, order) -> None:
+def sort_slots(body, cell_of, event, head, next_, items, where) -> None:
     """Renumber the slots in cell order (a counting sort), keeping every reference consistent.
 
-    ``order`` (N,) int32 is a work array; ``head`` doubles as the counting array and ``next_``
-    as the inverse permutation before both are rebuilt.
+    ``head`` doubles as the counting array and ``next_`` as each slot's new number before both
+    are rebuilt.
     """
     n = body.shape[0]
     head[:] = 0
@@ -482,38 +450,34 @@ def sort_slots(body, cell_of, event, head, next_, items, where, order) -> None:
         size = head[c]
         head[c] = start
         start += size
+    moved_to = next_
     for k in range(n):  # stable: slots keep their relative order within a cell
         c = cell_of[k]
-        order[head[c]] = k
+        moved_to[k] = head[c]
         head[c] += 1
-    inverse = next_
-    for new in range(n):
-        inverse[order[new]] = new
-    # Rows move in place along the cycles of the permutation (row ``new`` takes row
-    # ``order[new]``); a placed row's entry of ``order`` is flipped below 0.
-    for first in range(n):
-        at = first
-        while order[at] >= 0:
-            source = order[at]
-            order[at] = -1 - source
-            if source == first:
-                break
-            _swap_rows(body, at, source)
-            _swap_rows(event, at, source)
-            at = source
+    # References first, while the rows are still in place ...
     for k in range(n):
-        for column in (CODE, CACHED):
-            if event[k, column] >= 0:
-                event[k, column] = inverse[event[k, column]]
+        if event[k, CODE] >= 0:
+            event[k, CODE] = moved_to[event[k, CODE]]
     for s in range(n):
-        items[s] = inverse[items[s]]
+        items[s] = moved_to[items[s]]
+    # ... then the rows, in place along the cycles of the permutation: each swap puts the row
+    # at ``first`` in its place.
+    for first in range(n):
+        while moved_to[first] != first:
+            to = moved_to[first]
+            _swap_rows(body, first, to)
+            _swap_rows(event, first, to)
+            moved_to[first] = moved_to[to]
+            moved_to[to] = to
+    for s in range(n):
         where[items[s]] = s
     _link_cells(cell_of, head, next_)
 
 
 @_engine()
 def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event, keys, items,
-            where, order) -> None:  # fmt: skip
+            where) -> None:  # fmt: skip
     """Start a fresh queue at time ``now`` (s) from positions synchronised at ``now``.
 
     ``body``'s positions, velocities, radii and masses and ``ident`` are filled by the caller (see
@@ -531,13 +495,10 @@ def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event
         count[k] = 0
         event[k, CODE] = NO_EVENT
         event[k, PARTNER_COUNT] = 0
-        event[k, CACHED] = -1
-        event[k, CACHED_COUNT] = 0
         items[k] = k
-    sort_slots(body, cell_of, event, head, next_, items, where, order)
+    sort_slots(body, cell_of, event, head, next_, items, where)
     for k in range(n):
-        keys[k] = predict(k, now, -1, body, ident, geometry, grid, cell_of, head, next_, count,
-                          event)  # fmt: skip
+        keys[k] = predict(k, now, body, ident, geometry, grid, cell_of, head, next_, count, event)
     _heap_build(keys, items, where)
 
 
@@ -560,7 +521,6 @@ def run_events(
     keys: np.ndarray,
     items: np.ndarray,
     where: np.ndarray,
-    order: np.ndarray,
     tally: np.ndarray,
     impulse: np.ndarray,
     acceleration: np.ndarray,
@@ -605,12 +565,12 @@ def run_events(
     since_sort = 0
     while True:
         if since_sort >= sort_every:
-            sort_slots(body, cell_of, event, head, next_, items, where, order)
+            sort_slots(body, cell_of, event, head, next_, items, where)
             since_sort = 0
         t = keys[0]
         if t > until:
             break
-        k = earliest(keys, items, ident, order)
+        k = earliest(keys, items, ident)
         processed += 1
         since_sort += 1
         if t > instant:
@@ -620,7 +580,6 @@ def run_events(
         if at_instant > 100 * n + 10_000:
             return -1 - ident[k]
         code = event[k, CODE]
-        crossed = -1
         if code >= 0:
             j = code
             if count[j] == event[k, PARTNER_COUNT]:
@@ -628,18 +587,16 @@ def run_events(
                          midpoint)  # fmt: skip
                 count[k] += 1
                 count[j] += 1
-                t_j = predict(j, t, -1, body, ident, geometry, grid, cell_of, head, next_,
-                              count, event)  # fmt: skip
+                t_j = predict(j, t, body, ident, geometry, grid, cell_of, head, next_, count,
+                              event)  # fmt: skip
                 heap_update(j, t_j, keys, items, where)
         elif code >= WALL_CODES[1]:
             _bounce(k, -1 - code, t, body, ident, geometry, tally, impulse, acceleration, midpoint)
             count[k] += 1
         elif code >= CELL_CODES[1]:
-            crossed = -5 - code
             _advance(k, t, body)
-            _cross_cell(k, crossed, body, ident, image, geometry, grid, cell_of, head, next_)
-        t_k = predict(k, t, crossed, body, ident, geometry, grid, cell_of, head, next_, count,
-                      event)  # fmt: skip
+            _cross_cell(k, -5 - code, body, ident, image, geometry, grid, cell_of, head, next_)
+        t_k = predict(k, t, body, ident, geometry, grid, cell_of, head, next_, count, event)
         heap_update(k, t_k, keys, items, where)
     return processed
 
@@ -739,7 +696,7 @@ def _wall_response(v, upper, i, d, lead, acceleration):
 
 @_engine()
 def load(position, velocity, radius, mass, body, ident) -> None:
-    """Fill ``body`` (N, 8), or (N, 6) without radius and mass, and ``ident`` (N,) from the
+    """Fill ``body`` (N, 7), or (N, 5) without radius and mass, and ``ident`` (N,) from the
     particles, in particle order.
 
     Parameters
@@ -754,7 +711,6 @@ def load(position, velocity, radius, mass, body, ident) -> None:
         body[i, Y] = position[i, 1]
         body[i, VX] = velocity[i, 0]
         body[i, VY] = velocity[i, 1]
-        body[i, PAIR_TIME] = 0.0
         if body.shape[1] > MASS:
             body[i, RADIUS] = radius[i]
             body[i, MASS] = mass[i]
