@@ -400,7 +400,7 @@ def _engine_arrays(n: int, cells: int, columns: int = events.BODY_COLUMNS) -> di
     """Empty engine arrays for n particles and a grid of ``cells`` (all but geometry and grid),
     with ``body`` rows of ``columns`` (`events.BODY_COLUMNS` or `events.SHARED_BODY_COLUMNS`).
 
-    A slot's integers share one 24-byte row of ``event``: ``ident``, ``cell_of``, ``count`` and
+    A slot's integers share one 28-byte row of ``event``: ``ident``, ``cell_of``, ``count`` and
     ``where`` are views of its last columns, so the engine reads a slot in two rows (its ``body``
     row and this one).
     """

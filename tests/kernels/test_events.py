@@ -95,14 +95,18 @@ def test_slot_order_does_not_change_the_outcome(rng, boundary):
 
 def _by_particle(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """The engine's state indexed by particle instead of slot: body rows, the particle of each
-    event's partner (wall and cell codes kept), event times."""
+    event's partner and kept contact (-1 for none, wall and cell codes kept), event times."""
     ident = state["ident"]
     order = np.argsort(ident)
-    code = state["event"][order, events.CODE]
+    partner = {}
+    for column in (events.CODE, events.KEPT):
+        slots = state["event"][order, column]
+        partner[column] = np.where(slots >= 0, ident[np.maximum(slots, 0)], slots)
     return {
         "body": state["body"][order],
         "partner_count": state["event"][order, events.PARTNER_COUNT],
-        "code": np.where(code >= 0, ident[np.maximum(code, 0)], code),
+        "code": partner[events.CODE],
+        "kept": partner[events.KEPT],
         "cell": state["cell_of"][order],
         "count": state["count"][order],
         "time": state["keys"][state["where"][order]],
@@ -163,8 +167,9 @@ def test_sorting_slots_moves_every_reference_with_its_particle(rng):
 
 
 def test_engine_matches_twin_across_cell_crossings(rng):
-    """Small fast disks cross cells thousands of times, each crossing predicting against the
-    new neighbours; with few collisions the twin must find the same ones. (Reflecting box: in a
+    """Small fast disks cross cells thousands of times, so the short prediction after a crossing
+    (3 new cells and the kept earliest contact) is taken over and over; with few collisions the
+    twin must find the same ones. (Reflecting box: in a
     periodic one the twin, which looks at the 9 nearest images only, misses contacts more than a
     box side of free flight away.)"""
     boundary = "reflecting"

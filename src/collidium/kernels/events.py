@@ -24,14 +24,13 @@ Memory layout. At 1e5 particles and more the engine waits on memory, not arithme
   bytes (`SHARED_BODY_COLUMNS`): smaller rows mean more collisions per second at N = 1e5.
 - An event is one int32 code: the partner's slot (>= 0), a wall (`WALL_CODES`) or a cell
   crossing (`CELL_CODES`); indices are int32. The caller keeps all of a slot's integers in one
-  24-byte row (`SLOT_COLUMNS`), so a slot is two rows.
+  28-byte row (`SLOT_COLUMNS`), so a slot is two rows.
 - The heap's children of a node fill one cache line, and the kernels are compiled without
   numba's reference counting (`_engine`).
-- Memory: about 90 bytes per disk of one radius and mass at packing 0.3 (``body`` 40, integers
-  24, heap 12, cell lists 14), so a million disks fit in 300 MB with the interpreter and LLVM.
-  That is why a crossing re-predicts against all 9 cells: keeping the earliest contact found
-  before, to search only the 3 new cells, cost 16 bytes per disk for 7% at N = 1e4 and no
-  measurable gain at 1e5.
+- Memory: about 94 bytes per disk of one radius and mass at packing 0.3 (``body`` 40, integers
+  28, heap 12, cell lists 14), so a million disks fit in 300 MB with the interpreter and LLVM.
+  So the contact kept for the short prediction after a crossing (`predict`) is its partner
+  alone, 4 bytes, and its time is computed again when needed: storing it too would add 8.
 
 All state lives in arrays owned by the caller (`collidium.collisions.ExactCollisions`), so the queue
 survives from one call to the next: with no forces, dt is only a reporting interval.
@@ -58,12 +57,13 @@ SHARED_BODY_COLUMNS = 5  # 40 bytes: every disk has the radius and mass in ``geo
 HALF_WIDTH, HALF_HEIGHT, CELL_WIDTH, CELL_HEIGHT, SHARED_RADIUS, SHARED_MASS = range(6)
 GEOMETRY_SIZE = 6
 
-#: Columns of the ``event`` rows (int32): the next event's code and the partner's collision count
-#: when it was predicted (a later count makes the event stale).
-CODE, PARTNER_COUNT = range(2)
-EVENT_COLUMNS = 2
+#: Columns of the ``event`` rows (int32): the next event's code, the earliest pair contact found
+#: (its partner's slot, or -1; the event itself if it comes first) and that partner's collision
+#: count when it was predicted (a later count makes the contact stale).
+CODE, KEPT, PARTNER_COUNT = range(3)
+EVENT_COLUMNS = 3
 
-#: Columns after the event's in the rows the caller allocates, so that one 24-byte row holds
+#: Columns after the event's in the rows the caller allocates, so that one 28-byte row holds
 #: every integer of a slot (a slot's state is then two rows): the arrays ``ident``,
 #: ``cell_of``, ``count`` and ``where`` that the kernels take must be views of these columns,
 #: as `sort_slots` moves whole rows.
@@ -308,9 +308,39 @@ def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid):
 
 
 @_engine(inline="always")
-def _scan_cells(k, now, x, y, vx, vy, r, body, ident, geometry, grid, cell_of, head, next_):
-    """Earliest contact of slot k, at (x, y) at time ``now``, with the disks in the 9 cells
-    around it.
+def _delay_to(j, now, x, y, vx, vy, r, sx, sy, body, geometry) -> float:
+    """Time (s) from ``now`` until slot j, shifted by (sx, sy) m, touches a disk of radius r at
+    (x, y) moving at (vx, vy); inf if never or if j has radius 0."""
+    rj = _radius(j, body, geometry)
+    if rj <= 0.0:
+        return math.inf
+    lag_j = now - body[j, STAMP]
+    vjx = body[j, VX]
+    vjy = body[j, VY]
+    dx = body[j, X] + vjx * lag_j + sx - x
+    dy = body[j, Y] + vjy * lag_j + sy - y
+    sigma = r + rj
+    slack = CONTACT_SLACK * sigma * (abs(vx) + abs(vy) + abs(vjx) + abs(vjy))
+    return contact_delay(dx, dy, vjx - vx, vjy - vy, sigma, slack)
+
+
+@_engine(inline="always")
+def _delay_to_any_image(j, now, x, y, vx, vy, r, body, geometry, grid) -> float:
+    """`_delay_to` slot j, or in a periodic box to the image of j that comes first."""
+    if grid[2] == 0:
+        return _delay_to(j, now, x, y, vx, vy, r, 0.0, 0.0, body, geometry)
+    best = math.inf
+    for sx in (-2.0 * geometry[HALF_WIDTH], 0.0, 2.0 * geometry[HALF_WIDTH]):
+        for sy in (-2.0 * geometry[HALF_HEIGHT], 0.0, 2.0 * geometry[HALF_HEIGHT]):
+            best = min(best, _delay_to(j, now, x, y, vx, vy, r, sx, sy, body, geometry))
+    return best
+
+
+@_engine(inline="always")
+def _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry, grid, cell_of,
+                head, next_):  # fmt: skip
+    """Earliest contact of slot k, at (x, y) at time ``now``, with the disks in a block of cells
+    around its own: ``rows`` and ``columns`` are ``(first, last)`` offsets from k's cell.
 
     Returns ``(delay in s, partner slot)``, ``(inf, -1)`` if none; ties go to the lowest ident.
     """
@@ -322,27 +352,18 @@ def _scan_cells(k, now, x, y, vx, vy, r, body, ident, geometry, grid, cell_of, h
     c = cell_of[k]
     cx = c % ncx
     cy = c // ncx
-    speed = abs(vx) + abs(vy)
     best = math.inf
     best_slot = -1
     best_ident = -1
-    for oy in range(-1, 2):
-        for ox in range(-1, 2):
+    for oy in range(rows[0], rows[1] + 1):
+        for ox in range(columns[0], columns[1] + 1):
             cell, sx, sy = neighbour_cell(cx, cy, ox, oy, ncx, ncy, periodic, 2.0 * hw, 2.0 * hh)
             if cell < 0:
                 continue
             j = head[cell]
             while j >= 0:
-                rj = _radius(j, body, geometry)
-                if j != k and rj > 0.0:
-                    lag_j = now - body[j, STAMP]
-                    vjx = body[j, VX]
-                    vjy = body[j, VY]
-                    dx = body[j, X] + vjx * lag_j + sx - x
-                    dy = body[j, Y] + vjy * lag_j + sy - y
-                    sigma = r + rj
-                    slack = CONTACT_SLACK * sigma * (speed + abs(vjx) + abs(vjy))
-                    delay = contact_delay(dx, dy, vjx - vx, vjy - vy, sigma, slack)
+                if j != k:
+                    delay = _delay_to(j, now, x, y, vx, vy, r, sx, sy, body, geometry)
                     if delay < best or (delay == best and best_slot >= 0 and ident[j] < best_ident):
                         best, best_slot, best_ident = delay, j, ident[j]
                 j = next_[j]
@@ -350,8 +371,15 @@ def _scan_cells(k, now, x, y, vx, vy, r, body, ident, geometry, grid, cell_of, h
 
 
 @_engine(inline="always")
-def predict(k, now, body, ident, geometry, grid, cell_of, head, next_, count, event):
+def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, count, event):
     """Find slot k's next event after time ``now`` (s), store it, return its time (s).
+
+    The earliest pair contact found is kept (``event[k, KEPT]``): after a cell crossing in
+    direction ``crossed`` (0 -x, 1 +x, 2 -y, 3 +y; -1 for none) only the 3 cells newly in reach are
+    searched, and compared with the kept contact, recomputed, if its partner has not collided
+    since. That is exact: k's velocity did not change, the neighbours that did not change cannot
+    come earlier than the kept contact, and any neighbour that changed or arrived since has
+    predicted against k itself.
 
     ``geometry`` holds the box's half sides, the cell sides and any shared radius and mass
     (`HALF_WIDTH` to `SHARED_MASS`); ``grid`` is ``[ncx, ncy, periodic]``. Ties go to the first
@@ -366,13 +394,35 @@ def predict(k, now, body, ident, geometry, grid, cell_of, head, next_, count, ev
     r = _radius(k, body, geometry)
     when, code = _walls_and_cells(x, y, vx, vy, r, cell_of[k], geometry, grid)
     when += now
+    pair = -1
     if r > 0.0:
-        found, pair = _scan_cells(k, now, x, y, vx, vy, r, body, ident, geometry, grid, cell_of,
-                                  head, next_)  # fmt: skip
+        rows = (-1, 1)
+        columns = (-1, 1)
+        kept = event[k, KEPT]
+        # In a grid under 3 cells wide, periodic neighbours repeat under several shifts.
+        partial = (
+            crossed >= 0
+            and (kept < 0 or count[kept] == event[k, PARTNER_COUNT])
+            and grid[0] >= 3
+            and grid[1] >= 3
+        )
+        if partial:
+            edge = 1 if crossed % 2 == 1 else -1
+            if crossed < 2:
+                columns = (edge, edge)
+            else:
+                rows = (edge, edge)
+        found, pair = _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry,
+                                  grid, cell_of, head, next_)  # fmt: skip
+        if partial and kept >= 0:
+            again = _delay_to_any_image(kept, now, x, y, vx, vy, r, body, geometry, grid)
+            if pair < 0 or again < found or (again == found and ident[kept] < ident[pair]):
+                found, pair = again, kept
         if pair >= 0 and now + found < when:
             when, code = now + found, pair
     event[k, CODE] = code
-    event[k, PARTNER_COUNT] = count[code] if code >= 0 else 0
+    event[k, KEPT] = pair
+    event[k, PARTNER_COUNT] = count[pair] if pair >= 0 else 0
     return when
 
 
@@ -457,8 +507,9 @@ def sort_slots(body, cell_of, event, head, next_, items, where) -> None:
         head[c] += 1
     # References first, while the rows are still in place ...
     for k in range(n):
-        if event[k, CODE] >= 0:
-            event[k, CODE] = moved_to[event[k, CODE]]
+        for column in (CODE, KEPT):
+            if event[k, column] >= 0:
+                event[k, column] = moved_to[event[k, column]]
     for s in range(n):
         items[s] = moved_to[items[s]]
     # ... then the rows, in place along the cycles of the permutation: each swap puts the row
@@ -494,11 +545,13 @@ def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event
         )
         count[k] = 0
         event[k, CODE] = NO_EVENT
+        event[k, KEPT] = -1
         event[k, PARTNER_COUNT] = 0
         items[k] = k
     sort_slots(body, cell_of, event, head, next_, items, where)
     for k in range(n):
-        keys[k] = predict(k, now, body, ident, geometry, grid, cell_of, head, next_, count, event)
+        keys[k] = predict(k, now, -1, body, ident, geometry, grid, cell_of, head, next_, count,
+                          event)  # fmt: skip
     _heap_build(keys, items, where)
 
 
@@ -580,6 +633,7 @@ def run_events(
         if at_instant > 100 * n + 10_000:
             return -1 - ident[k]
         code = event[k, CODE]
+        crossed = -1
         if code >= 0:
             j = code
             if count[j] == event[k, PARTNER_COUNT]:
@@ -587,16 +641,18 @@ def run_events(
                          midpoint)  # fmt: skip
                 count[k] += 1
                 count[j] += 1
-                t_j = predict(j, t, body, ident, geometry, grid, cell_of, head, next_, count,
-                              event)  # fmt: skip
+                t_j = predict(j, t, -1, body, ident, geometry, grid, cell_of, head, next_,
+                              count, event)  # fmt: skip
                 heap_update(j, t_j, keys, items, where)
         elif code >= WALL_CODES[1]:
             _bounce(k, -1 - code, t, body, ident, geometry, tally, impulse, acceleration, midpoint)
             count[k] += 1
         elif code >= CELL_CODES[1]:
+            crossed = -5 - code
             _advance(k, t, body)
-            _cross_cell(k, -5 - code, body, ident, image, geometry, grid, cell_of, head, next_)
-        t_k = predict(k, t, body, ident, geometry, grid, cell_of, head, next_, count, event)
+            _cross_cell(k, crossed, body, ident, image, geometry, grid, cell_of, head, next_)
+        t_k = predict(k, t, crossed, body, ident, geometry, grid, cell_of, head, next_, count,
+                      event)  # fmt: skip
         heap_update(k, t_k, keys, items, where)
     return processed
 
