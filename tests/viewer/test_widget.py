@@ -10,7 +10,7 @@ import pytest
 from collidium.errors import InputError
 from collidium.presets import preset
 from collidium.viewer import Widget, protocol
-from collidium.viewer.server import STATIC
+from collidium.viewer.server import STATIC, TICK
 
 
 @pytest.fixture
@@ -95,6 +95,15 @@ def test_the_widget_front_end_runs_in_chromium_against_the_widget(browser, viewe
     def to_kernel(content: dict) -> list[list]:
         replies.clear()
         shown._on_message(shown, content, [])
+        # In Jupyter the kernel's event loop also ticks the widget every TICK; here only the
+        # page's messages do, so tick on until a running simulation gives its next frame (an
+        # ack that comes before the state moved on would otherwise get none, and the page waits).
+        deadline = time.monotonic() + 1.0
+        while shown.connection.session.playing and time.monotonic() < deadline:
+            if any(b for _, b in replies):
+                break
+            time.sleep(TICK)
+            shown._deliver(shown.connection.tick())
         return [[c, base64.b64encode(b[0]).decode() if b else None] for c, b in replies]
 
     page = browser.new_page(viewport={"width": 1000, "height": 900})

@@ -7,8 +7,10 @@ import math
 import numba
 import numpy as np
 
+from collidium.kernels.stepper import chunk_count
 
-@numba.njit(cache=True)
+
+@numba.njit(cache=True, parallel=True)
 def first_invalid(
     position: np.ndarray,
     velocity: np.ndarray,
@@ -40,17 +42,30 @@ def first_invalid(
     """
     limit_x = half_width * (1.0 + tolerance)
     limit_y = half_height * (1.0 + tolerance)
-    for i in range(position.shape[0]):
-        x = position[i, 0]
-        y = position[i, 1]
-        if not (
-            math.isfinite(x)
-            and math.isfinite(y)
-            and math.isfinite(velocity[i, 0])
-            and math.isfinite(velocity[i, 1])
-        ):
-            return i, 1
-        reach = 0.0 if periodic else radius[i]
-        if abs(x) + reach > limit_x or abs(y) + reach > limit_y:
-            return i, 2
+    n = position.shape[0]
+    chunks = chunk_count(n)
+    first = np.full(chunks, n)  # each chunk's first invalid particle (n: none) and why
+    reason = np.zeros(chunks, dtype=np.int64)
+    for p in numba.prange(chunks):
+        for i in range(p * n // chunks, (p + 1) * n // chunks):
+            why = _invalid(position[i, 0], position[i, 1], velocity[i, 0], velocity[i, 1],
+                           0.0 if periodic else radius[i], limit_x, limit_y)  # fmt: skip
+            if why:
+                first[p] = i
+                reason[p] = why
+                break
+    for p in range(chunks):
+        if first[p] < n:
+            return first[p], reason[p]
     return -1, 0
+
+
+@numba.njit(cache=True, inline="always")
+def _invalid(x, y, vx, vy, reach, limit_x, limit_y) -> int:
+    """1 if the position or velocity is not finite, 2 if the disk reaches past the limits, else
+    0."""
+    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(vx) and math.isfinite(vy)):
+        return 1
+    if abs(x) + reach > limit_x or abs(y) + reach > limit_y:
+        return 2
+    return 0
