@@ -58,18 +58,18 @@ def test_placement_equals_twin(rng):
     np.testing.assert_array_equal(got, want)
 
 
+@pytest.mark.parametrize("n", [200, 20_000])
 @pytest.mark.parametrize("periodic", [False, True])
-def test_audit_equals_twin(rng, periodic):
-    """The audit runs in parallel chunks (4 at this N): the first bad particle is still found,
+def test_audit_equals_twin(rng, periodic, n):
+    """In one pass, or in parallel chunks (4 at N = 20,000): the first bad particle is found,
     wherever the bad ones lie."""
-    n = 20_000
     position = rng.uniform(-4.9, 4.9, (n, 2))
     velocity = rng.normal(0, 1, (n, 2))
     radius = np.full(n, 0.05)
     half = np.array([5.0, 5.0])
     assert first_invalid(position, velocity, radius, 5.0, 5.0, periodic, 1e-9) == (-1, 0)
-    cases = [[(57, "position", [4.97, 0.0])], [(19_999, "velocity", [np.nan, 0.0])],
-             [(12_000, "position", [0.0, -5.2]), (5_001, "velocity", [0.0, np.inf])]]  # fmt: skip
+    two_chunks = [(3 * n // 5, "position", [0.0, -5.2]), (n // 4 + 1, "velocity", [0.0, np.inf])]
+    cases = [[(57, "position", [4.97, 0.0])], [(n - 1, "velocity", [np.nan, 0.0])], two_chunks]
     for bad in cases:
         p, v = position.copy(), velocity.copy()
         for index, field, value in bad:
