@@ -21,17 +21,16 @@ def _per_particle(name: str, value: ArrayLike, n: int) -> FloatArray:
         array = np.array(value, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise InputError(name, f"not a number or list of numbers ({exc})") from None
-    if array.ndim == 0:
-        array = np.broadcast_to(array, (n,))
-    elif array.shape != (n,):
+    if array.ndim > 0 and array.shape != (n,):
         raise InputError(name, f"expected a scalar or {n} values, got shape {array.shape}")
-    _check_finite(name, array)
-    wrong = {"mass": array <= 0, "radius": array < 0}.get(name)
+    values = array.reshape(-1)  # a shared value is checked once, as particle 0's
+    _check_finite(name, values)
+    wrong = {"mass": values <= 0, "radius": values < 0}.get(name)
     if wrong is not None and wrong.any():
         i = int(np.flatnonzero(wrong)[0])
         sign = ">" if name == "mass" else ">="
-        raise InputError(name, f"must be {sign} 0, particle {i} has {float(array[i])!r}")
-    return array
+        raise InputError(name, f"must be {sign} 0, particle {i} has {float(values[i])!r}")
+    return np.broadcast_to(array, (n,)) if array.ndim == 0 else array
 
 
 def _check_finite(name: str, values: FloatArray) -> None:
