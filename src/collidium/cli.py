@@ -14,12 +14,15 @@ import tomllib
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from pydantic import ValidationError
 
 from collidium.errors import InputError, SimulationError
+
+if TYPE_CHECKING:
+    from collidium.runner import Job
 
 app = typer.Typer(
     name="collidium",
@@ -29,6 +32,14 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 
+MaxDriftOption = Annotated[
+    float | None,
+    typer.Option(
+        "--max-drift",
+        help="Fail (exit 1) if the total energy drifts by more than this fraction of its "
+        "initial value (without it, a drift over 1e-3 only warns).",
+    ),
+]
 SetOption = Annotated[
     list[str] | None,
     typer.Option(
@@ -88,8 +99,9 @@ def run_command(
         int | None,
         typer.Option("--checkpoint-every", help="Also write the checkpoint every this many steps."),
     ] = None,
+    max_drift: MaxDriftOption = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
-) -> None:
+) -> int:
     """Run a preset or scenario file and print a summary."""
     from collidium.loading import load_scenario
     from collidium.runner import Job, execute
@@ -107,21 +119,25 @@ def run_command(
         end_step=count, out=None if out is None else str(out), every=frame_period,
         checkpoint=None if checkpoint is None else str(checkpoint),
         checkpoint_every=checkpoint_every, observers=spec.to_dict().get("observers", []),
+        max_drift=max_drift,
     )  # fmt: skip
     sim = spec.build()
-    _report(execute(sim, job, progress=not as_json and sys.stderr.isatty()), as_json)
+    return _report(execute(sim, job, progress=not as_json and sys.stderr.isatty()), job, as_json)
 
 
 @app.command("resume")
 def resume_command(
     checkpoint: Annotated[Path, typer.Argument(help="Checkpoint written by run --checkpoint.")],
+    max_drift: MaxDriftOption = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
-) -> None:
+) -> int:
     """Finish an interrupted run from its checkpoint (bitwise the same as never stopping)."""
-    from collidium.runner import execute, resume
+    from collidium.runner import Job, execute, resume
 
     sim, job = resume(checkpoint)
-    _report(execute(sim, job, progress=not as_json and sys.stderr.isatty()), as_json)
+    if max_drift is not None:
+        job.max_drift = Job(end_step=job.end_step, max_drift=max_drift).max_drift  # checked
+    return _report(execute(sim, job, progress=not as_json and sys.stderr.isatty()), job, as_json)
 
 
 @app.command("inspect")
@@ -221,11 +237,17 @@ def _trajectory_of(
         return read_trajectory(recording)
 
 
-def _report(summary: dict[str, Any], as_json: bool) -> None:
+def _report(summary: dict[str, Any], job: Job, as_json: bool) -> int:
+    """Print the summary; exit status 1 if the energy drifted past ``--max-drift``."""
+    from collidium.runner import drift_exceeded
+
     if as_json:
         typer.echo(json.dumps(summary))
     else:
         _print_summary(summary)
+    if job.max_drift is not None and drift_exceeded(job):
+        return _fail(f"--max-drift: {summary['energy']['warning']}", 1)
+    return 0
 
 
 @app.command("export")
@@ -346,6 +368,7 @@ def _print_summary(summary: dict[str, Any]) -> None:
         ("potential energy", f"{energy['potential']:.10g} J"),
         ("total energy", f"{energy['total']:.10g} J"),
         ("max relative energy drift", "n/a" if drift is None else f"{drift:.3g}"),
+        *([("warning", energy["warning"])] if energy.get("warning") else []),
         ("momentum", "({:.6g}, {:.6g}) kg m/s".format(*summary["momentum"])),
         ("pair collisions", f"{summary['collisions']['pair']}"),
         ("wall collisions", f"{summary['collisions']['wall']}"),

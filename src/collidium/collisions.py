@@ -15,6 +15,7 @@ to a `Tally`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Literal, Protocol
 
@@ -56,6 +57,26 @@ class Tally:
     impulse: FloatArray = field(default_factory=_zeros_float)
 
 
+@dataclass(frozen=True)
+class Contact:
+    """A collision or wall hit at which a drift halted, before processing it.
+
+    Attributes
+    ----------
+    time : float
+        When the contact happens on the drift's straight paths, in s (absolute).
+    particle : int
+        Index of a particle in it.
+    partner : int
+        The other particle's index (>= 0), or ``-1 - wall`` for a wall (0 left, 1 right,
+        2 bottom, 3 top).
+    """
+
+    time: float
+    particle: int
+    partner: int
+
+
 class Drift(Protocol):
     """A drift mode: moves particles over one step and counts collisions."""
 
@@ -67,11 +88,17 @@ class Drift(Protocol):
         dt: float,
         tally: Tally,
         acceleration: FloatArray | None = None,
-    ) -> None:
+        halt_after: float = math.inf,
+    ) -> Contact | None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place, adding to ``tally``.
 
         ``acceleration`` (N, 2), in m/s^2, is that of the step's half kicks when forces act; a mode
         may use it to time collisions within the step consistently with the kicks.
+
+        A mode with exact contact times stops at the first collision or wall hit after
+        ``halt_after`` (s) of a particle with a non-zero acceleration and returns it, leaving
+        ``particles`` and ``tally`` part-way (the caller restores them); other modes, and every
+        mode when nothing halts it, return None.
         """
 
     def state(self) -> dict[str, np.ndarray]:
@@ -148,8 +175,9 @@ class NoCollisions(_Stateless):
         dt: float,
         tally: Tally,
         acceleration: FloatArray | None = None,
+        halt_after: float = math.inf,
     ) -> None:
-        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place (never halts)."""
         _free_flight(particles, box, dt, tally)
 
 
@@ -241,8 +269,9 @@ class StepCollisions(_Stateless):
         dt: float,
         tally: Tally,
         acceleration: FloatArray | None = None,
+        halt_after: float = math.inf,
     ) -> None:
-        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place (never halts)."""
         _free_flight(particles, box, dt, tally)
         if particles.n == 0:
             return
@@ -289,6 +318,7 @@ class ExactCollisions:
         self.rebuilds = 0
         #: Events per particle between re-sorts of the engine's memory by cell (speed only).
         self.sort_interval = events.SORT_INTERVAL
+        self._halt = np.full(events.HALT_SIZE, math.inf)
 
     def state(self) -> dict[str, np.ndarray]:
         """The event queue and lazily updated positions, and the event counters."""
@@ -351,8 +381,10 @@ class ExactCollisions:
         dt: float,
         tally: Tally,
         acceleration: FloatArray | None = None,
-    ) -> None:
-        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place."""
+        halt_after: float = math.inf,
+    ) -> Contact | None:
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place, or halt before the first
+        contact of forced particles after ``halt_after`` (s) and return it (`Drift.drift`)."""
         _refuse_runaway(particles, box, dt)
         if not self._is_current(particles):
             self._state = self._rebuild(particles, box, now)
@@ -360,12 +392,14 @@ class ExactCollisions:
         s = self._state
         assert s is not None
         until = now + dt
+        halt = self._halt
+        halt[events.HALT_AFTER] = halt_after
         processed = events.run_events(
             until, s["body"], s["ident"], particles.image, s["geometry"], s["grid"], s["cell_of"],
             s["head"], s["next"], s["count"], s["event"], s["keys"], s["items"], s["where"],
             tally.counts, tally.impulse,
             _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
-            max(1, self.sort_interval * particles.n),
+            max(1, self.sort_interval * particles.n), halt,
         )  # fmt: skip
         if processed < 0:
             self._state = None  # the queue is unusable; a later drift rebuilds it
@@ -376,8 +410,16 @@ class ExactCollisions:
                 "step's start); the state has run away: try a smaller dt or softening"
             )
         self.events += processed
+        if not math.isnan(halt[events.HALT_TIME]):
+            self._state = None  # part-way through the drift: rebuilt from the restored particles
+            return Contact(
+                float(halt[events.HALT_TIME]),
+                int(halt[events.HALT_PARTICLE]),
+                int(halt[events.HALT_PARTNER]),
+            )
         events.synchronise(until, s["body"], s["ident"], particles.position, particles.velocity)
         self._synced_at = until
+        return None
 
 
 def _cache_aligned_rows(

@@ -12,7 +12,7 @@ import numpy as np
 from collidium.containers import Box
 from collidium.errors import InputError
 from collidium.kernels import tree
-from collidium.kernels.pairwise import coulomb_direct
+from collidium.kernels.pairwise import coulomb_direct, coulomb_stiffness
 from collidium.state import FloatArray, Particles
 
 SumMethod = Literal["auto", "direct", "tree"]
@@ -120,6 +120,30 @@ class Coulomb:
             box.width, box.height, box.periodic, force, energy, virial,
         )  # fmt: skip
 
+    def stiffness(self, particles: Particles, box: Box, acceleration: FloatArray) -> float:
+        """How fast this force's energies change: ``S`` in J^2/s^4, such that a leapfrog step h
+        errs on the energy by about ``sqrt(S) h^2`` (`collidium.integrators`).
+
+        Summed directly, the sum over pairs of ``(|U_ij| rate_ij^2)^2``
+        (`collidium.kernels.pairwise.coulomb_stiffness`), O(N^2) like the sum itself. Summed by
+        tree, which has no pair list, the same from each particle's acceleration ``|a_i|``
+        (``acceleration`` (N, 2), m/s^2) and speed over ``l_i``, its diameter or the softening
+        length, whichever is larger (the mean spacing for point particles without softening):
+        ``|U_i| = m_i |a_i| l_i`` and ``rate_i^2 = (|v_i|^2 / l_i + |a_i|) / l_i``.
+        """
+        if not self.uses_tree(particles, box):
+            return coulomb_stiffness(
+                particles.position, particles.velocity, particles.charge, particles.mass, self.k,
+                self.softening**2, box.width, box.height, box.periodic,
+            )  # fmt: skip
+        length = np.maximum(2.0 * particles.radius, self.softening)
+        spacing = math.sqrt(box.width * box.height / max(particles.n, 1))
+        length = np.where(length > 0.0, length, spacing)
+        pull = np.hypot(acceleration[:, 0], acceleration[:, 1])
+        speed2 = np.einsum("ij,ij->i", particles.velocity, particles.velocity)
+        error = particles.mass * pull * (speed2 / length + pull)
+        return float(np.sum(error * error))
+
     def limit(self, acceleration: FloatArray) -> None:
         """Apply the smooth acceleration cap in place (no-op without ``max_acceleration``)."""
         if self.max_acceleration is None:
@@ -194,6 +218,11 @@ class ForceField:
         self._virial_sum = virial
         self._evaluated_at = particles.position.copy()
         return self._acceleration
+
+    def stiffness(self, particles: Particles, box: Box) -> float:
+        """``S`` of all forces at the current state, in J^2/s^4 (`Coulomb.stiffness`; the
+        acceleration of the last `evaluate` is used where one is needed)."""
+        return sum(force.stiffness(particles, box, self._acceleration) for force in self.forces)
 
     def potential(self, particles: Particles, box: Box) -> float:
         """Potential energy in J at the current positions (cached from the last evaluation)."""

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from collidium.errors import InputError
+from collidium.integrators import DEFAULT_TOLERANCE
 
 if TYPE_CHECKING:
     from collidium.scenario import Scenario
@@ -37,13 +38,18 @@ _COMMON: dict[str, Any] = {
     "dt": 0.01,
     "time": 10.0,
     "collisions": "exact",
+    "integrator": "adaptive",
+    "tolerance": DEFAULT_TOLERANCE,
     "mass": 1.0,
     "radius": 0.25,
     "width": 20.0,
     "height": 20.0,
     "boundary": "reflecting",
 }
-_NEUTRAL = ("seed", "dt", "time", "collisions", "mass", "radius", "width", "height")
+_NEUTRAL = (
+    "seed", "dt", "time", "collisions", "integrator", "tolerance", "mass", "radius", "width",
+    "height",
+)  # fmt: skip
 #: A preset taking ``k`` has a Coulomb force (softened by ``softening``).
 _CHARGED = ("k", *_NEUTRAL)
 
@@ -117,7 +123,9 @@ def _scenario(name: str, values: dict[str, Any]) -> Scenario:
                 "height": values["height"],
                 "boundary": values["boundary"],
             },
-            "run": {"dt": values["dt"], "time": values["time"], "collisions": values["collisions"]},
+            "run": {
+                key: values[key] for key in ("dt", "time", "collisions", "integrator", "tolerance")
+            },
             "forces": forces,
             "particles": particles,
         }

@@ -38,6 +38,10 @@ OUTPUT_SUFFIXES = (".gsd", ".xyz")
 #: How many samples the run's own measurements take at most (their collision parts are exact).
 SAMPLES = 500
 
+#: Largest relative energy drift a run reports without a warning (``--max-drift`` sets another
+#: and makes passing it a failure). The adaptive integrator keeps the seed scenes below 1e-5.
+DRIFT_WARNING = 1e-3
+
 
 @dataclass
 class Job:
@@ -61,6 +65,8 @@ class Job:
         Total energy at the start of the whole run (kept across resumes), J.
     max_rel_drift : float
         Largest relative energy drift from ``initial_total`` so far.
+    max_drift : float or None
+        The drift past which the run fails (``--max-drift``); None warns past `DRIFT_WARNING`.
     """
 
     end_step: int
@@ -71,8 +77,13 @@ class Job:
     observers: list[dict[str, Any]] = field(default_factory=list)
     initial_total: float | None = None
     max_rel_drift: float = 0.0
+    max_drift: float | None = None
 
     def __post_init__(self) -> None:
+        if self.max_drift is not None and not (
+            isinstance(self.max_drift, int | float) and self.max_drift > 0  # also refuses NaN
+        ):
+            raise InputError("--max-drift", f"must be a number > 0, got {self.max_drift!r}")
         if self.every < 1:
             raise InputError("--every", f"must be >= 1 step, got {self.every}")
         if self.checkpoint_every is not None and self.checkpoint_every < 1:
@@ -272,6 +283,7 @@ def summarise(
     summary["wall_seconds"] = wall_seconds
     summary["energy"]["initial_total"] = job.initial_total
     summary["energy"]["max_rel_drift"] = job.max_rel_drift
+    summary["energy"]["warning"] = drift_warning(job)
     summary |= thermo.summary()
     summary["collisions"]["rate"] = rate.rate
     summary["collisions"]["mean_free_time"] = rate.mean_free_time
@@ -283,6 +295,24 @@ def summarise(
             {"observer": type(o).__name__} | o.summary() for o in reported if o.sampled
         ]
     return finite(summary)
+
+
+def drift_exceeded(job: Job) -> bool:
+    """Whether the run's energy drifted past its limit (``max_drift``, else `DRIFT_WARNING`).
+    A drift that cannot be measured (a zero initial energy) never counts."""
+    limit = DRIFT_WARNING if job.max_drift is None else job.max_drift
+    return math.isfinite(job.max_rel_drift) and job.max_rel_drift > limit
+
+
+def drift_warning(job: Job) -> str | None:
+    """One line saying that the energy drifted past the run's limit, or None."""
+    if not drift_exceeded(job):
+        return None
+    limit = DRIFT_WARNING if job.max_drift is None else job.max_drift
+    return (
+        f"the total energy drifted by {job.max_rel_drift:.3g} of its initial value (limit "
+        f"{limit:g}): try a smaller run.tolerance, or a smaller dt with the fixed integrator"
+    )
 
 
 def finite(value: Any) -> Any:

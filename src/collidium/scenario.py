@@ -12,9 +12,11 @@ A scenario file::
     boundary = "reflecting"       # or "periodic"
 
     [run]
-    dt = 0.01                     # s
+    dt = 0.01                     # s, the reporting interval
     time = 10.0                   # s, default duration of `collidium run`
     collisions = "exact"          # "exact" | "step" | "off"
+    integrator = "adaptive"       # "adaptive" (substeps as the forces need) | "fixed" (seed's)
+    tolerance = 0.0005            # the adaptive integrator's accuracy (energy error ~ its square)
 
     [[forces]]
     type = "coulomb"
@@ -62,6 +64,7 @@ from collidium.containers import Box
 from collidium.errors import InputError
 from collidium.forces import DEFAULT_THETA, Coulomb
 from collidium.initial import balanced_charges, random_positions, rhombus_rack, uniform_velocities
+from collidium.integrators import DEFAULT_TOLERANCE
 from collidium.io.trajectory import GSDWriter
 from collidium.observers import (
     After,
@@ -140,13 +143,16 @@ class BoxSpec(_Model):
 
 
 class RunSpec(_Model):
-    """Time step (s), default duration (s) and collision mode."""
+    """Time step (s, the reporting interval), default duration (s), collision mode, and the
+    integrator with its tolerance (`collidium.integrators`)."""
 
     model_config = ConfigDict(extra="forbid", strict=True)
 
     dt: Positive = 0.01
     time: NonNegative = 10.0
     collisions: Literal["exact", "step", "off"] = "exact"
+    integrator: Literal["adaptive", "fixed"] = "adaptive"
+    tolerance: Positive = DEFAULT_TOLERANCE
 
 
 class CoulombSpec(_Model):
@@ -547,7 +553,12 @@ class Scenario(_Model):
                 "description": f"the state of {sim.name} at t = {sim.time:.6g} s",
                 "seed": sim.seed or 0,
                 "box": {"width": box.width, "height": box.height, "boundary": box.boundary},
-                "run": {"dt": sim.dt, "collisions": sim.collisions},
+                "run": {
+                    "dt": sim.dt,
+                    "collisions": sim.collisions,
+                    "integrator": sim.integrator,
+                    "tolerance": sim.tolerance,
+                },
                 "forces": [force.to_dict() for force in sim.forces],
                 "particles": [
                     {
@@ -609,6 +620,7 @@ class Scenario(_Model):
             sim = Simulation(
                 box, particles, forces=[force.build() for force in self.forces], dt=self.run.dt,
                 collisions=self.run.collisions, seed=self.seed, name=self.name,
+                integrator=self.run.integrator, tolerance=self.run.tolerance,
             )  # fmt: skip
         except InputError as exc:
             if exc.particles:
@@ -650,6 +662,8 @@ _SIMULATION_FIELDS = {
     "charge": "particles.charge",
     "dt": "run.dt",
     "collisions": "run.collisions",
+    "integrator": "run.integrator",
+    "tolerance": "run.tolerance",
 }
 
 

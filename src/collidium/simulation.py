@@ -1,14 +1,15 @@
 """`Simulation`: owns the state, the vessel, the forces, the integrator and the observers.
 
-Run loop, one step of length dt:
+Run loop, one step of length dt (the reporting interval):
 
-1. kick: ``v += a dt/2`` (only with forces);
-2. drift: the collision mode moves the particles for dt (exact events, the seed's step method, or
-   pass-through), reflecting from walls or wrapping in a periodic box;
-3. forces at the new positions, kick: ``v += a dt/2``;
-4. ``time += dt``, ``steps += 1``;
-5. audit: a NaN/infinity or a particle outside the vessel stops the run with `SimulationError`;
-6. observers whose trigger fires (``trigger(sim)``) are updated.
+1. the integrator (`collidium.integrators`) advances the state by dt: kick ``v += a h/2``, drift
+   for h (the collision mode: exact events, the seed's step method, or pass-through, reflecting
+   from walls or wrapping in a periodic box), forces at the new positions, kick ``v += a h/2``;
+   ``"adaptive"`` takes as many substeps h as the forces need, ``"fixed"`` one of h = dt, and
+   without forces both are a single drift;
+2. ``time += dt``, ``steps += 1``;
+3. audit: a NaN/infinity or a particle outside the vessel stops the run with `SimulationError`;
+4. observers whose trigger fires (``trigger(sim)``) are updated.
 """
 
 from __future__ import annotations
@@ -26,7 +27,13 @@ from collidium.collisions import COLLISION_MODES, CollisionMode, Tally, make_dri
 from collidium.containers import OUTSIDE_TOLERANCE, Box
 from collidium.errors import InputError, SimulationError
 from collidium.forces import Coulomb, ForceField
-from collidium.integrators import Leapfrog
+from collidium.integrators import (
+    DEFAULT_TOLERANCE,
+    INTEGRATORS,
+    Integrator,
+    IntegratorName,
+    make_integrator,
+)
 from collidium.io.checkpoint import read_checkpoint, write_checkpoint
 from collidium.kernels.audit import first_invalid
 from collidium.kernels.cells import first_overlap, grid_shape
@@ -81,6 +88,13 @@ class Simulation:
         between reports: the motion is exact whatever its value.
     collisions : {"exact", "step", "off"}
         Collision handling, see `collidium.collisions`.
+    integrator : {"adaptive", "fixed"}
+        Time stepping with forces, see `collidium.integrators`: "adaptive" substeps inside each dt
+        as the forces need (energy error ~ ``tolerance^2``), "fixed" one leapfrog step of dt (the
+        seed's scheme). The same without forces.
+    tolerance : float
+        The adaptive integrator's accuracy parameter (> 0): the largest substep as a fraction of
+        the fastest pair time scale.
     seed : int, optional
         Seed of the simulation's random generator (`rng`).
     name : str, optional
@@ -89,9 +103,11 @@ class Simulation:
     Raises
     ------
     InputError
-        For a bad dt or mode, disks too large for the box, overlapping disks (the pair is named) or
-        a particle outside the vessel.
+        For a bad dt, mode, integrator or tolerance, disks too large for the box, overlapping
+        disks (the pair is named) or a particle outside the vessel.
     """
+
+    _integrator: Integrator
 
     def __init__(
         self,
@@ -102,8 +118,11 @@ class Simulation:
         collisions: CollisionMode = "exact",
         seed: int | None = None,
         name: str | None = None,
+        integrator: IntegratorName = "adaptive",
+        tolerance: float = DEFAULT_TOLERANCE,
     ) -> None:
         _check_setup(container, particles, forces, dt, collisions)
+        _check_integrator(integrator, tolerance)
         if container.periodic:
             wrapped = container.wrap(particles.position)
             size = container.size
@@ -111,6 +130,8 @@ class Simulation:
             particles.position[...] = wrapped
         _check_placement(container, particles, collisions)
         self._setup(container, particles, forces, dt, collisions, seed, name)
+        self._tolerance = float(tolerance)
+        self._integrator = make_integrator(integrator, tolerance)
 
     def _setup(
         self,
@@ -135,7 +156,8 @@ class Simulation:
         self._attached: list[Observer] = []  # observers already attached (by identity)
         self._field = ForceField(tuple(forces))
         self._drift = make_drift(collisions)
-        self._integrator = Leapfrog()
+        self._tolerance = DEFAULT_TOLERANCE
+        self._integrator = make_integrator("adaptive", DEFAULT_TOLERANCE)
         self.tally = Tally()
 
     @property
@@ -171,6 +193,28 @@ class Simulation:
         if mode != self._collisions:
             self._collisions = mode
             self._drift = make_drift(mode)
+
+    @property
+    def integrator(self) -> IntegratorName:
+        """Time stepping with forces: "adaptive" or "fixed"; may be changed between runs."""
+        return self._integrator.name
+
+    @integrator.setter
+    def integrator(self, name: IntegratorName) -> None:
+        _check_integrator(name, self.tolerance)
+        if name != self._integrator.name:
+            self._integrator = make_integrator(name, self.tolerance)
+
+    @property
+    def tolerance(self) -> float:
+        """The adaptive integrator's accuracy parameter (kept, unused, by "fixed")."""
+        return self._tolerance
+
+    @tolerance.setter
+    def tolerance(self, value: float) -> None:
+        _check_integrator(self.integrator, value)
+        self._tolerance = float(value)
+        self._integrator = make_integrator(self.integrator, value)
 
     @property
     def forces(self) -> tuple[Coulomb, ...]:
@@ -331,6 +375,7 @@ class Simulation:
         # A value all particles share is saved once, and comes back shared.
         properties = {name: np.asarray(as_given(getattr(p, name))) for name in PROPERTIES}
         drift = {f"drift/{key}": value for key, value in self._drift.state().items()}
+        drift |= {f"integrator/{key}": value for key, value in self._integrator.state().items()}
         arrays = {
             "position": p.position, "velocity": p.velocity, "image": p.image,
             "tally/counts": self.tally.counts, "tally/impulse": self.tally.impulse,
@@ -344,6 +389,8 @@ class Simulation:
             "time_origin": list(self._time_origin),
             "steps": self.steps,
             "collisions": self.collisions,
+            "integrator": self.integrator,
+            "tolerance": self.tolerance,
             "seed": self.seed,
             "rng": self.rng.bit_generator.state,
         }
@@ -396,6 +443,16 @@ def restore_with_meta(path: str | Path) -> tuple[Simulation, dict[str, Any]]:
         # overlaps): it is taken as saved, without the placement checks of a new simulation.
         sim._setup(container, particles, forces, state["dt"], state["collisions"], state["seed"],
                    state["name"])  # fmt: skip
+        # Checkpoints from before the adaptive integrator continue with the step they were made by.
+        integrator, tolerance = state.get("integrator", "fixed"), state.get("tolerance")
+        tolerance = DEFAULT_TOLERANCE if tolerance is None else tolerance
+        _check_integrator(integrator, tolerance)
+        sim._tolerance = float(tolerance)
+        sim._integrator = make_integrator(integrator, tolerance)
+        sim._integrator.load_state(
+            {k.removeprefix("integrator/"): v for k, v in arrays.items()
+             if k.startswith("integrator/")}
+        )  # fmt: skip
         sim._time_origin = (float(state["time_origin"][0]), int(state["time_origin"][1]))
         sim.steps = int(state["steps"])
         sim.rng.bit_generator.state = state["rng"]
@@ -456,6 +513,18 @@ def _check_forces(forces: Sequence[Coulomb], container: Box) -> None:
         if not isinstance(force, Coulomb):
             raise InputError(f"forces.{k}", f"unknown force {type(force).__name__}")
         force.check_box(container)
+
+
+def _check_integrator(integrator: str, tolerance: float) -> None:
+    if integrator not in INTEGRATORS:
+        raise InputError("integrator", f"must be one of {INTEGRATORS}, got {integrator!r}")
+    if (
+        isinstance(tolerance, bool)
+        or not isinstance(tolerance, int | float)
+        or not math.isfinite(tolerance)
+        or tolerance <= 0
+    ):
+        raise InputError("tolerance", f"must be a finite number > 0, got {tolerance!r}")
 
 
 def _check_mode(collisions: str) -> None:

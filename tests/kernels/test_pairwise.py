@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from collidium.kernels import reference
-from collidium.kernels.pairwise import coulomb_direct
+from collidium.kernels.pairwise import coulomb_direct, coulomb_stiffness
 
 
 def _coulomb(position, charge, k=5.0, eps2=0.0, size=None):
@@ -105,3 +105,28 @@ def test_neutral_particles_feel_and_exert_nothing(rng):
     want = _coulomb(position[charged], charge[charged])
     np.testing.assert_array_equal(force[charged], want[0])
     np.testing.assert_array_equal(energy[charged], want[1])
+
+
+@pytest.mark.parametrize("n", [2, 40, 300])  # 300 charges: rows in parallel
+@pytest.mark.parametrize("periodic", [False, True])
+def test_stiffness_equals_numpy_twin(rng, n, periodic):
+    position = rng.uniform(-8, 8, (n, 2))
+    velocity = rng.normal(0.0, 3.0, (n, 2))
+    charge = rng.choice([-1.0, 2.0, 0.0], n)
+    charge[:2] = 1.0
+    mass = rng.uniform(0.1, 2.0, n)
+    size = np.array([16.0, 16.0]) if periodic else None
+    got = coulomb_stiffness(position, velocity, charge, mass, 5.0, 0.01, 16.0, 16.0, periodic)
+    want = reference.coulomb_stiffness(position, velocity, charge, mass, 5.0, 0.01, size)
+    assert got == pytest.approx(want, rel=1e-12)
+
+
+def test_stiffness_of_a_pair_is_its_energy_times_its_squared_rate():
+    """Two charges 2 m apart closing at 3 m/s: |U| = 5 * 2 / 2, rate^2 = (9 + |U| * 2) / 4."""
+    position = np.array([[-1.0, 0.0], [1.0, 0.0]])
+    velocity = np.array([[1.5, 0.0], [-1.5, 0.0]])
+    charge, mass = np.array([1.0, -2.0]), np.array([1.0, 1.0])
+    got = coulomb_stiffness(position, velocity, charge, mass, 5.0, 0.0, 0.0, 0.0, False)
+    assert got == pytest.approx((5.0 * (9.0 + 10.0) / 4.0) ** 2, rel=1e-14)
+    charge[1] = 0.0  # a neutral particle counts for nothing
+    assert coulomb_stiffness(position, velocity, charge, mass, 5.0, 0.0, 0.0, 0.0, False) == 0.0

@@ -70,6 +70,11 @@ EVENT_COLUMNS = 3
 IDENT, CELL, COUNT, WHERE = range(EVENT_COLUMNS, EVENT_COLUMNS + 4)
 SLOT_COLUMNS = EVENT_COLUMNS + 4
 
+#: Entries of the ``halt`` array of `run_events`: in, the time after which a contact of forced
+#: particles halts the drift; out, that contact's time, particle and partner (or ``-1 - wall``).
+HALT_AFTER, HALT_TIME, HALT_PARTICLE, HALT_PARTNER = range(4)
+HALT_SIZE = 4
+
 #: Children per node of the event queue's heap: 8 keys fill one 64-byte line, and the heap is a
 #: third as deep as a binary one.
 ARITY = 8
@@ -579,6 +584,7 @@ def run_events(
     acceleration: np.ndarray,
     midpoint: float,
     sort_every: int,
+    halt: np.ndarray,
 ) -> int:
     """Process every event up to time ``until`` (inclusive) in time order.
 
@@ -599,6 +605,14 @@ def run_events(
     sort_every : int
         Events between two re-sorts of the slots (`sort_slots`); the outcome does not depend on
         it, only the speed.
+    halt : ndarray of float64, shape (4,)
+        ``halt[HALT_AFTER]`` (s): a pair collision or wall hit later than this time, of a
+        particle with a non-zero ``acceleration``, stops the drift before it is processed; its
+        time and particles go to ``halt[HALT_TIME]``, ``halt[HALT_PARTICLE]`` and
+        ``halt[HALT_PARTNER]`` (the partner, or ``-1 - wall``); ``halt[HALT_TIME]`` is NaN if
+        the drift ran to ``until``. Infinity never halts. The engine's state is then part-way
+        through the drift: the caller rebuilds it (`collidium.integrators` takes such a drift
+        again, shorter, so that the contact falls between two substeps).
     (other arrays)
         Engine state as built by `rebuild`; updated in place.
 
@@ -610,6 +624,7 @@ def run_events(
         contacts allow, which only a runaway state (huge or infinite velocities) produces.
     """
     processed = 0
+    halt[HALT_TIME] = math.nan
     n = body.shape[0]
     if n == 0:
         return 0
@@ -624,6 +639,8 @@ def run_events(
         if t > until:
             break
         k = earliest(keys, items, ident)
+        if t > halt[HALT_AFTER] and _halts(k, t, body, ident, count, event, acceleration, halt):
+            break
         processed += 1
         since_sort += 1
         if t > instant:
@@ -655,6 +672,33 @@ def run_events(
                       event)  # fmt: skip
         heap_update(k, t_k, keys, items, where)
     return processed
+
+
+@_engine(inline="always")
+def _halts(k, t, body, ident, count, event, acceleration, halt) -> bool:
+    """Whether slot k's event at time t is a contact that halts the drift (see `run_events`):
+    a valid pair collision or a wall hit with a force on one of its particles. Records it."""
+    if acceleration.shape[0] == 0:
+        return False
+    code = event[k, CODE]
+    if code >= 0:
+        if count[code] != event[k, PARTNER_COUNT]:
+            return False  # stale
+        partner = ident[code]
+    elif code >= WALL_CODES[1]:
+        partner = code
+    else:
+        return False  # a cell crossing
+    i = ident[k]
+    forced = acceleration[i, 0] != 0.0 or acceleration[i, 1] != 0.0
+    if partner >= 0:
+        forced = forced or acceleration[partner, 0] != 0.0 or acceleration[partner, 1] != 0.0
+    if not forced:
+        return False
+    halt[HALT_TIME] = t
+    halt[HALT_PARTICLE] = i
+    halt[HALT_PARTNER] = partner
+    return True
 
 
 @_engine(inline="always")

@@ -177,3 +177,120 @@ def coulomb_direct(
         force[i, 1] = below[1] + above[1]
         energy[i] = 0.5 * (below[2] + above[2])
         virial[i] = 0.5 * (below[3] + above[3])
+
+
+@numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def _stiffness_row(
+    c: int,
+    x: np.ndarray,
+    y: np.ndarray,
+    vx: np.ndarray,
+    vy: np.ndarray,
+    q: np.ndarray,
+    inverse_mass: np.ndarray,
+    k: float,
+    softening2: float,
+    width: float,
+    height: float,
+    periodic: bool,
+) -> float:
+    """Sum of ``(|U_ij| rate_ij^2)^2`` of row c against the rows after it
+    (`coulomb_stiffness`)."""
+    stiffness = 0.0
+    for j in range(c + 1, x.shape[0]):
+        dx = x[c] - x[j]
+        dy = y[c] - y[j]
+        if periodic:
+            dx -= width * round(dx / width)
+            dy -= height * round(dy / height)
+        s2 = dx * dx + dy * dy + softening2
+        dvx = vx[c] - vx[j]
+        dvy = vy[c] - vy[j]
+        u = k * abs(q[c] * q[j]) / math.sqrt(s2)
+        error = u * (dvx * dvx + dvy * dvy + u * (inverse_mass[c] + inverse_mass[j])) / s2
+        stiffness += error * error
+    return stiffness
+
+
+#: Charged particles from which `coulomb_stiffness` runs its rows in parallel (below, starting
+#: the threads costs more than the rows).
+PARALLEL_STIFFNESS_FROM = 256
+
+
+@numba.njit(cache=True, parallel=True)
+def _stiffness_parallel(x, y, vx, vy, q, inverse_mass, k, softening2, width, height, periodic):
+    m = x.shape[0]
+    rows = np.zeros(m)
+    for c in numba.prange(m):
+        rows[c] = _stiffness_row(
+            c, x, y, vx, vy, q, inverse_mass, k, softening2, width, height, periodic
+        )
+    return rows.sum()
+
+
+@numba.njit(cache=True)
+def coulomb_stiffness(
+    position: np.ndarray,
+    velocity: np.ndarray,
+    charge: np.ndarray,
+    mass: np.ndarray,
+    k: float,
+    softening2: float,
+    width: float,
+    height: float,
+    periodic: bool,
+) -> float:
+    """How fast the Coulomb pair energies change, for the adaptive integrator's substeps.
+
+    For each pair of charged particles, with ``s^2 = r^2 + eps^2`` (minimum image when
+    ``periodic``), ``|U_ij| = k |q_i q_j| / s`` and the squared rate
+    ``rate_ij^2 = (|v_i - v_j|^2 + |U_ij| (1/m_i + 1/m_j)) / s^2``: fly-by plus free fall, the
+    inverse square of the time in which the pair's force turns or grows appreciably. A leapfrog
+    step h errs on the pair's energy by about ``|U_ij| rate_ij^2 h^2``; the pairs' errors are
+    taken as independent, so they add in quadrature: the result is the sum of
+    ``(|U_ij| rate_ij^2)^2`` (`collidium.integrators`). Rows are summed in a fixed order: the
+    result does not depend on the number of threads.
+
+    Parameters
+    ----------
+    position, velocity : ndarray, shape (N, 2)
+        In m and m/s.
+    charge, mass : ndarray, shape (N,)
+        In C and kg.
+    k : float
+        Coulomb constant in N m^2 / C^2.
+    softening2 : float
+        Squared softening length in m^2.
+    width, height : float
+        Box sides in m (minimum image when ``periodic``).
+    periodic : bool
+        Minimum-image convention.
+
+    Returns
+    -------
+    float
+        The sum over pairs of ``(|U_ij| rate_ij^2)^2`` in J^2/s^4 (0 with fewer than two charges).
+    """
+    n = position.shape[0]
+    m = 0
+    for i in range(n):
+        if charge[i] != 0.0:
+            m += 1
+    x, y = np.empty(m), np.empty(m)
+    vx, vy = np.empty(m), np.empty(m)
+    q, inverse_mass = np.empty(m), np.empty(m)
+    c = 0
+    for i in range(n):
+        if charge[i] != 0.0:
+            x[c], y[c] = position[i, 0], position[i, 1]
+            vx[c], vy[c] = velocity[i, 0], velocity[i, 1]
+            q[c], inverse_mass[c] = charge[i], 1.0 / mass[i]
+            c += 1
+    if m >= PARALLEL_STIFFNESS_FROM:
+        return _stiffness_parallel(x, y, vx, vy, q, inverse_mass, k, softening2, width, height,
+                                   periodic)  # fmt: skip
+    stiffness = 0.0
+    for c in range(m):
+        stiffness += _stiffness_row(c, x, y, vx, vy, q, inverse_mass, k, softening2, width, height,
+                                    periodic)  # fmt: skip
+    return stiffness

@@ -71,6 +71,30 @@ def coulomb_direct_on(
     return force
 
 
+def coulomb_stiffness(
+    position: FloatArray,
+    velocity: FloatArray,
+    charge: FloatArray,
+    mass: FloatArray,
+    k: float,
+    softening2: float,
+    size: FloatArray | None = None,
+) -> float:
+    """The sum over charged pairs of ``(|U_ij| rate_ij^2)^2`` (J^2/s^4), all pairs at once, with
+    ``|U_ij| = k |q_i q_j| / s``, ``rate_ij^2 = (|v_ij|^2 + |U_ij| (1/m_i + 1/m_j)) / s^2`` and
+    ``s^2 = r^2 + eps^2``. ``size`` (the box sides) turns on the minimum image."""
+    charged = charge != 0.0
+    x, v, q, m = position[charged], velocity[charged], charge[charged], mass[charged]
+    d = x[:, None, :] - x[None, :, :]
+    if size is not None:
+        d -= size * np.round(d / size)
+    s2 = np.einsum("ijk,ijk->ij", d, d) + softening2
+    w = v[:, None, :] - v[None, :, :]
+    u = k * np.abs(q[:, None] * q[None, :]) / np.sqrt(s2)
+    error = u * (np.einsum("ijk,ijk->ij", w, w) + u * (1 / m[:, None] + 1 / m[None, :])) / s2
+    return float(np.sum(error[np.triu_indices(q.size, 1)] ** 2))
+
+
 def first_overlap(position: FloatArray, radius: FloatArray) -> tuple[int, int]:
     """The overlapping pair with the smallest (i, j), or (-1, -1); all pairs, reflecting box."""
     d = np.linalg.norm(position[:, None] - position[None, :], axis=2)

@@ -1,0 +1,125 @@
+"""Time stepping: the adaptive integrator holds the seed's charged scenes at their own dt."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numba
+import numpy as np
+import pytest
+
+import collidium as cd
+from collidium.errors import InputError
+from collidium.integrators import DEFAULT_TOLERANCE
+from collidium.observers import EnergyDrift
+
+
+def max_drift(sim: cd.Simulation, time: float) -> float:
+    """Largest |E(t) - E(0)| / |E(0)| over every step of a run of ``time`` s."""
+    drift = EnergyDrift()
+    sim.observers.append(drift)
+    sim.run(time=time)
+    return drift.max_rel_drift
+
+
+# The issue's targets at each preset's defaults (dt = 0.01 s): (preset, seconds, bound). The
+# charged gas is held to its bound over 2 s here (60 s take minutes; the benchmark runs them).
+TARGETS = [
+    ("orbit", 60.0, 1e-6),
+    ("charged-like", 60.0, 1e-6),
+    ("charged-opposite", 60.0, 1e-6),
+    ("charged-no-collisions", 20.0, 1e-5),
+    pytest.param("bohr-atom", 20.0, 1e-5, marks=pytest.mark.slow),
+    pytest.param("charged-gas", 2.0, 1e-5, marks=pytest.mark.slow),
+]
+
+
+@pytest.mark.parametrize(("name", "time", "bound"), TARGETS)
+def test_seed_scenes_hold_their_energy_at_the_seed_dt(name, time, bound):
+    assert cd.load(name).dt == 0.01
+    assert max_drift(cd.load(name), time) <= bound
+    # The same scene with the seed's single step misses the bound: the substeps do the work.
+    assert max_drift(cd.load(name, integrator="fixed"), min(time, 10.0)) > bound
+
+
+def test_halving_the_tolerance_quarters_the_error():
+    errors = [max_drift(cd.load("orbit", tolerance=tol), 20.0) for tol in (0.004, 0.002, 0.001)]
+    for coarse, fine in itertools.pairwise(errors):
+        assert 2.5 < coarse / fine < 6.0  # second order: 4, within the substep count's steps
+
+
+def test_fixed_step_error_falls_about_four_times_per_halving_of_dt():
+    """The seed's behaviour, reproducible: leapfrog is second order."""
+    errors = [max_drift(cd.load("orbit", integrator="fixed", dt=dt), 20.0) for dt in (0.02, 0.01)]
+    assert 3.0 < errors[0] / errors[1] < 5.0
+
+
+def test_without_forces_the_exact_engine_is_untouched():
+    """No forces: one drift per step, bitwise what the fixed step (and earlier versions) do."""
+    adaptive = cd.load("gas", n=300).run(time=2.0)
+    fixed = cd.load("gas", n=300, integrator="fixed").run(time=2.0)
+    np.testing.assert_array_equal(adaptive.particles.position, fixed.particles.position)
+    np.testing.assert_array_equal(adaptive.particles.velocity, fixed.particles.velocity)
+    assert adaptive._drift.rebuilds == fixed._drift.rebuilds == 1
+    assert adaptive._drift.events == fixed._drift.events
+
+
+def test_substeps_follow_the_dynamics():
+    """The point charges need many substeps as they pass through each other, few elsewhere."""
+    sim = cd.load("charged-no-collisions")
+    counts = []
+    for _ in range(400):
+        sim.run(steps=1)
+        counts.append(sim._integrator.substeps)
+    assert min(counts) <= 4 and max(counts) >= 256
+
+
+def test_checkpoint_resumes_bitwise(tmp_path):
+    whole = cd.load("bohr-atom").run(time=1.0)
+    part = cd.load("bohr-atom").run(time=0.5)
+    part.save(tmp_path / "run.ckpt")
+    resumed = cd.restore(tmp_path / "run.ckpt")
+    assert resumed.integrator == "adaptive" and resumed.tolerance == DEFAULT_TOLERANCE
+    resumed.run(time=0.5)
+    np.testing.assert_array_equal(resumed.particles.position, whole.particles.position)
+    np.testing.assert_array_equal(resumed.particles.velocity, whole.particles.velocity)
+    assert resumed.counters == whole.counters
+
+
+def test_results_do_not_depend_on_the_number_of_threads():
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("needs two threads")
+    before = numba.get_num_threads()
+    runs = []
+    try:
+        for threads in (1, 2):
+            numba.set_num_threads(threads)
+            runs.append(cd.load("charged-gas", n=300).run(time=0.05))  # parallel pair rows
+    finally:
+        numba.set_num_threads(before)
+    np.testing.assert_array_equal(runs[0].particles.position, runs[1].particles.position)
+    np.testing.assert_array_equal(runs[0].particles.velocity, runs[1].particles.velocity)
+
+
+def test_integrator_and_tolerance_can_change_between_runs():
+    sim = cd.load("orbit")
+    sim.integrator = "fixed"
+    sim.tolerance = 0.01
+    assert (sim.integrator, sim.tolerance) == ("fixed", 0.01)
+    sim.integrator = "adaptive"
+    assert sim._integrator.tolerance == 0.01
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [("tolerance", 0.0), ("tolerance", -1.0), ("tolerance", math.nan), ("tolerance", math.inf),
+     ("tolerance", True), ("integrator", "rk4")],
+)  # fmt: skip
+def test_bad_integrator_settings_name_the_field(field, value):
+    with pytest.raises(InputError) as caught:
+        setattr(cd.load("orbit"), field, value)
+    assert caught.value.field == field
+    with pytest.raises(InputError) as caught:
+        cd.load("orbit", **{field: value})
+    assert caught.value.field in (field, f"run.{field}")
