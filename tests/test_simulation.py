@@ -91,7 +91,8 @@ def test_step_mode_loses_no_particle_in_pool_break():
 
 
 def _max_energy_error(name: str, dt: float, time: float) -> float:
-    sim = cd.load(name, dt=dt)
+    """The largest relative energy error with the seed's fixed step."""
+    sim = cd.load(name, dt=dt, integrator="fixed")
     drift = cd.observers.EnergyDrift()
     sim.observers.append(drift)
     sim.run(time=time)
@@ -100,9 +101,9 @@ def _max_energy_error(name: str, dt: float, time: float) -> float:
 
 @pytest.mark.parametrize("name", ["orbit", "charged-like"])
 def test_halving_dt_cuts_the_energy_error_about_four_times(name):
-    """Leapfrog's bounded energy error is O(dt^2), so the ratio is 4 up to higher-order terms.
-    charged-like also bounces off walls, where the kick-timing correction (kernels/events.py)
-    keeps the error O(dt^2)."""
+    """The seed's fixed step: leapfrog's bounded energy error is O(dt^2), so the ratio is 4 up
+    to higher-order terms. charged-like also bounces off walls, where the kick-timing correction
+    (kernels/events.py) keeps the error O(dt^2)."""
     coarse = _max_energy_error(name, 0.02, 10.0)
     fine = _max_energy_error(name, 0.01, 10.0)
     assert 3.5 < coarse / fine < 4.5
@@ -116,7 +117,9 @@ def _worst_error_of_one_collision(dt: float) -> float:
         particles = cd.Particles(
             [[-5.0 - offset, 0.0], [5.0 + offset, 0.0]], [[2.0, 0.0], [-2.0, 0.0]], charge=[1, -1]
         )
-        sim = cd.Simulation(cd.Box(20, 20), particles, forces=[cd.Coulomb(k=5.0)], dt=dt)
+        sim = cd.Simulation(
+            cd.Box(20, 20), particles, forces=[cd.Coulomb(k=5.0)], dt=dt, integrator="fixed"
+        )
         e0 = sim.energy().total
         sim.run(time=3.0)
         assert sim.counters.pair_collisions == 1
@@ -125,10 +128,11 @@ def _worst_error_of_one_collision(dt: float) -> float:
 
 
 def test_collision_under_forces_keeps_the_energy_error_second_order():
-    """A single collision's energy error depends on where in the step the contact falls, so one
-    run's ratio is noisy; its worst case over the phase is not. Plain reflection inside a kicked
-    step leaves an O(dt) error (ratio 2 when dt halves); the kick-timing correction makes it
-    O(dt^2): measured 3.7 at these dt, approaching 4 as dt shrinks."""
+    """With the fixed step, a single collision's energy error depends on where in the step the
+    contact falls, so one run's ratio is noisy; its worst case over the phase is not. Plain
+    reflection inside a kicked step leaves an O(dt) error (ratio 2 when dt halves); the
+    kick-timing correction makes it O(dt^2): measured 3.7 at these dt, approaching 4 as dt
+    shrinks."""
     assert 3.2 < _worst_error_of_one_collision(0.005) / _worst_error_of_one_collision(0.0025) < 4.5
 
 

@@ -122,9 +122,10 @@ class Coulomb:
 
     def stiffness(self, particles: Particles, box: Box, acceleration: FloatArray) -> float:
         """How fast this force's energies change: ``S`` in J^2/s^4, such that a leapfrog step h
-        errs on the energy by about ``sqrt(S) h^2`` (`collidium.integrators`).
+        errs on the energy of the pair that is hardest to follow by about ``sqrt(S) h^2``
+        (`collidium.integrators`).
 
-        Summed directly, the sum over pairs of ``(|U_ij| rate_ij^2)^2``
+        Summed directly, the largest ``(|U_ij| rate_ij^2)^2`` over pairs
         (`collidium.kernels.pairwise.coulomb_stiffness`), O(N^2) like the sum itself. Summed by
         tree, which has no pair list, the same from each particle's acceleration ``|a_i|``
         (``acceleration`` (N, 2), m/s^2) and speed over ``l_i``, its diameter or the softening
@@ -142,7 +143,7 @@ class Coulomb:
         pull = np.hypot(acceleration[:, 0], acceleration[:, 1])
         speed2 = np.einsum("ij,ij->i", particles.velocity, particles.velocity)
         error = particles.mass * pull * (speed2 / length + pull)
-        return float(np.sum(error * error))
+        return float(np.max(error * error, initial=0.0))
 
     def limit(self, acceleration: FloatArray) -> None:
         """Apply the smooth acceleration cap in place (no-op without ``max_acceleration``)."""
@@ -220,9 +221,13 @@ class ForceField:
         return self._acceleration
 
     def stiffness(self, particles: Particles, box: Box) -> float:
-        """``S`` of all forces at the current state, in J^2/s^4 (`Coulomb.stiffness`; the
-        acceleration of the last `evaluate` is used where one is needed)."""
-        return sum(force.stiffness(particles, box, self._acceleration) for force in self.forces)
+        """``S`` of all forces at the current state, in J^2/s^4: the largest of the forces'
+        (`Coulomb.stiffness`; the acceleration of the last `evaluate` is used where one is
+        needed)."""
+        return max(
+            (force.stiffness(particles, box, self._acceleration) for force in self.forces),
+            default=0.0,
+        )
 
     def potential(self, particles: Particles, box: Box) -> float:
         """Potential energy in J at the current positions (cached from the last evaluation)."""

@@ -14,6 +14,7 @@ Without forces both are the same single drift: the exact engine is then untouche
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Literal, Protocol
 
 import numpy as np
@@ -29,11 +30,15 @@ INTEGRATORS: tuple[IntegratorName, ...] = ("adaptive", "fixed")
 #: The adaptive integrator's default accuracy parameter: the largest substep as a fraction of the
 #: fastest pair time scale. It keeps every seed scene's energy error within the documented
 #: targets at dt = 0.01 s (README); the energy error scales as its square.
-DEFAULT_TOLERANCE = 0.0005
+DEFAULT_TOLERANCE = 0.0007
 
 #: Most regular substeps in one reporting interval (a power of two); past it the interval is
 #: taken with this many and the energy check of the run reports the error.
 MAX_SUBSTEPS = 2**16
+
+#: The energy scale of the substep criterion is the total energy, but at least ``KE + |U|``
+#: divided by this.
+TOTAL_ENERGY_FLOOR = 10.0
 
 #: Contacts less than this fraction of ``dt`` after a substep starts are taken inside its drift:
 #: they are the ones a substep was shortened for, now at the very start of the drift, where the
@@ -121,12 +126,11 @@ class AdaptiveLeapfrog:
 
     The interval ``dt`` is cut into ``n`` equal substeps, ``n`` a power of two, the smallest with
     ``dt / n <= tolerance * tau`` at every substep boundary of the interval. ``tau`` is the time
-    scale of the forces weighted by energy:
-    ``1 / tau^2 = sqrt(sum_ij (|U_ij| rate_ij^2)^2) / (KE + |U|)``, with ``rate_ij`` a pair's
-    fly-by and free-fall rate (`ForceField.stiffness`): a substep then errs on the energy by about
-    ``tolerance^2`` of its scale, the pairs' errors taken as independent (added in quadrature),
-    so that a lone pair in a close approach counts in full and the many far pairs of a gas by
-    their share. An interval
+    scale of the forces weighted by energy: ``1 / tau^2 = max_ij |U_ij| rate_ij^2 / |E|``, with
+    ``rate_ij`` a pair's fly-by and free-fall rate (`ForceField.stiffness`) and ``E`` the total
+    energy (at least a tenth of ``KE + |U|``): a substep then errs on the energy by about
+    ``tolerance^2`` of it, a lone pair in a close approach counting in full and a close pair of a
+    gas by its share of the gas's energy. An interval
     that turns out to need more substeps than it was given is taken again from its start with
     more. The check covers both ends of every substep, so the choice is the same run forwards or
     backwards (time-symmetric): the energy error stays bounded instead of drifting, and scales as
@@ -206,14 +210,15 @@ class AdaptiveLeapfrog:
         n: int,
     ) -> float:
         """Take the interval in ``n`` regular substeps (each split at contacts); returns the
-        largest squared rate (1/s^2) met at their boundaries."""
+        largest squared rate (1/s^2) met at their boundaries (the regular ones: they are the same
+        forwards and backwards, and contacts come with their own substep boundaries)."""
         fastest = _squared_rate(particles, box, field)
         t = now
         for s in range(1, n + 1):
             end = now + dt * s / n
-            while t < end:
+            while t < end:  # substeps shortened for contacts end at a contact, not at ``end``
                 t = self._substep(particles, box, field, drift, t, end, dt, tally)
-                fastest = max(fastest, _squared_rate(particles, box, field))
+            fastest = max(fastest, _squared_rate(particles, box, field))
         return fastest
 
     def _substep(
@@ -246,13 +251,15 @@ class AdaptiveLeapfrog:
 
 
 def _squared_rate(particles: Particles, box: Box, field: ForceField) -> float:
-    """The squared rate of the forces weighted by energy, 1/s^2: ``sqrt(S)`` (the pairs' energy
-    errors per squared second added in quadrature, `ForceField.stiffness`) over the energy scale
-    ``KE + |U|``. A leapfrog step h then errs on the energy by about ``h^2 rate^2`` of that
-    scale."""
+    """The squared rate of the forces weighted by energy, 1/s^2: ``sqrt(S)`` (the energy error per
+    squared second of the pair hardest to follow, `ForceField.stiffness`) over the total energy
+    ``|KE + U|``, the scale the energy error is judged against, but never below a tenth of
+    ``KE + |U|`` (a total near zero would ask for endless substeps). A leapfrog step h then errs on
+    the energy by about ``h^2 rate^2`` of that scale."""
     p = particles
     kinetic = 0.5 * float(np.sum(p.mass * np.einsum("ij,ij->i", p.velocity, p.velocity)))
-    scale = kinetic + abs(field.potential(particles, box))
+    potential = field.potential(particles, box)
+    scale = max(abs(kinetic + potential), (kinetic + abs(potential)) / TOTAL_ENERGY_FLOOR)
     return math.sqrt(field.stiffness(particles, box)) / scale if scale > 0.0 else 0.0
 
 
@@ -274,25 +281,27 @@ def _shortened(
     """
     straight = contact.time - t
     i, j = contact.particle, contact.partner
-    p = particles
-    if j >= 0:
-        r = box.minimum_image(p.position[i] - p.position[j])
-        w = p.velocity[i] - p.velocity[j]
-        b = acceleration[i] - acceleration[j]
-        sigma = p.radius[i] + p.radius[j]
+    x, v, a = particles.position, particles.velocity, acceleration
+    if j >= 0:  # plain floats: a handful of Newton steps on scalars
+        rx, ry = (float(c) for c in box.minimum_image(x[i] - x[j]))
+        wx, wy = float(v[i, 0] - v[j, 0]), float(v[i, 1] - v[j, 1])
+        bx, by = float(a[i, 0] - a[j, 0]), float(a[i, 1] - a[j, 1])
+        sigma = float(particles.radius[i] + particles.radius[j])
 
         def gap(s: float) -> tuple[float, float]:
-            d = r + w * s + 0.5 * b * s * s
-            return float(d @ d - sigma * sigma), float(2.0 * d @ (w + b * s))
+            dx, dy = rx + (wx + 0.5 * bx * s) * s, ry + (wy + 0.5 * by * s) * s
+            slope = 2.0 * (dx * (wx + bx * s) + dy * (wy + by * s))
+            return dx * dx + dy * dy - sigma * sigma, slope
     else:
         wall = -1 - j
         axis, upper = wall // 2, wall % 2 == 1
         half = 0.5 * (box.width, box.height)[axis]
-        target = (half - p.radius[i]) if upper else (p.radius[i] - half)
-        x, v, a = p.position[i, axis], p.velocity[i, axis], acceleration[i, axis]
+        radius = float(particles.radius[i])
+        target = (half - radius) if upper else (radius - half)
+        x0, v0, a0 = float(x[i, axis]), float(v[i, axis]), float(a[i, axis])
 
         def gap(s: float) -> tuple[float, float]:
-            return float(x + v * s + 0.5 * a * s * s - target), float(v + a * s)
+            return x0 + (v0 + 0.5 * a0 * s) * s - target, v0 + a0 * s
 
     root = _newton(gap, straight)
     if not (math.isfinite(root) and 0.0 < root <= h):
@@ -300,11 +309,13 @@ def _shortened(
     return max(root - CONTACT_MARGIN * dt, 0.5 * root)
 
 
-def _newton(function: object, guess: float, iterations: int = 30) -> float:
+def _newton(
+    function: Callable[[float], tuple[float, float]], guess: float, iterations: int = 30
+) -> float:
     """A root of ``function(s) -> (value, derivative)`` from ``guess`` (NaN if none is found)."""
     s = guess
     for _ in range(iterations):
-        value, slope = function(s)  # type: ignore[operator]
+        value, slope = function(s)
         if slope == 0.0 or not math.isfinite(value):
             return math.nan
         step = value / slope

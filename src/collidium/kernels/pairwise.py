@@ -194,7 +194,7 @@ def _stiffness_row(
     height: float,
     periodic: bool,
 ) -> float:
-    """Sum of ``(|U_ij| rate_ij^2)^2`` of row c against the rows after it
+    """Largest ``(|U_ij| rate_ij^2)^2`` of row c against the rows after it
     (`coulomb_stiffness`)."""
     stiffness = 0.0
     for j in range(c + 1, x.shape[0]):
@@ -208,7 +208,7 @@ def _stiffness_row(
         dvy = vy[c] - vy[j]
         u = k * abs(q[c] * q[j]) / math.sqrt(s2)
         error = u * (dvx * dvx + dvy * dvy + u * (inverse_mass[c] + inverse_mass[j])) / s2
-        stiffness += error * error
+        stiffness = max(stiffness, error * error)
     return stiffness
 
 
@@ -225,7 +225,7 @@ def _stiffness_parallel(x, y, vx, vy, q, inverse_mass, k, softening2, width, hei
         rows[c] = _stiffness_row(
             c, x, y, vx, vy, q, inverse_mass, k, softening2, width, height, periodic
         )
-    return rows.sum()
+    return rows.max() if m else 0.0
 
 
 @numba.njit(cache=True)
@@ -246,10 +246,9 @@ def coulomb_stiffness(
     ``periodic``), ``|U_ij| = k |q_i q_j| / s`` and the squared rate
     ``rate_ij^2 = (|v_i - v_j|^2 + |U_ij| (1/m_i + 1/m_j)) / s^2``: fly-by plus free fall, the
     inverse square of the time in which the pair's force turns or grows appreciably. A leapfrog
-    step h errs on the pair's energy by about ``|U_ij| rate_ij^2 h^2``; the pairs' errors are
-    taken as independent, so they add in quadrature: the result is the sum of
-    ``(|U_ij| rate_ij^2)^2`` (`collidium.integrators`). Rows are summed in a fixed order: the
-    result does not depend on the number of threads.
+    step h errs on the pair's energy by about ``|U_ij| rate_ij^2 h^2``: the result is the largest
+    ``(|U_ij| rate_ij^2)^2`` over pairs, the pair whose energy is the hardest to follow
+    (`collidium.integrators`). A maximum does not depend on the number of threads.
 
     Parameters
     ----------
@@ -269,7 +268,8 @@ def coulomb_stiffness(
     Returns
     -------
     float
-        The sum over pairs of ``(|U_ij| rate_ij^2)^2`` in J^2/s^4 (0 with fewer than two charges).
+        The largest ``(|U_ij| rate_ij^2)^2`` over pairs, in J^2/s^4 (0 with fewer than two
+        charges).
     """
     n = position.shape[0]
     m = 0
@@ -291,6 +291,7 @@ def coulomb_stiffness(
                                    periodic)  # fmt: skip
     stiffness = 0.0
     for c in range(m):
-        stiffness += _stiffness_row(c, x, y, vx, vy, q, inverse_mass, k, softening2, width, height,
-                                    periodic)  # fmt: skip
+        row = _stiffness_row(c, x, y, vx, vy, q, inverse_mass, k, softening2, width, height,
+                             periodic)  # fmt: skip
+        stiffness = max(stiffness, row)
     return stiffness

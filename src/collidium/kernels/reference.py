@@ -80,7 +80,7 @@ def coulomb_stiffness(
     softening2: float,
     size: FloatArray | None = None,
 ) -> float:
-    """The sum over charged pairs of ``(|U_ij| rate_ij^2)^2`` (J^2/s^4), all pairs at once, with
+    """The largest ``(|U_ij| rate_ij^2)^2`` (J^2/s^4) over charged pairs, all pairs at once, with
     ``|U_ij| = k |q_i q_j| / s``, ``rate_ij^2 = (|v_ij|^2 + |U_ij| (1/m_i + 1/m_j)) / s^2`` and
     ``s^2 = r^2 + eps^2``. ``size`` (the box sides) turns on the minimum image."""
     charged = charge != 0.0
@@ -92,7 +92,7 @@ def coulomb_stiffness(
     w = v[:, None, :] - v[None, :, :]
     u = k * np.abs(q[:, None] * q[None, :]) / np.sqrt(s2)
     error = u * (np.einsum("ijk,ijk->ij", w, w) + u * (1 / m[:, None] + 1 / m[None, :])) / s2
-    return float(np.sum(error[np.triu_indices(q.size, 1)] ** 2))
+    return float(np.max(error[np.triu_indices(q.size, 1)] ** 2, initial=0.0))
 
 
 def first_overlap(position: FloatArray, radius: FloatArray) -> tuple[int, int]:
