@@ -311,6 +311,7 @@ class ExactCollisions:
 
     def __init__(self) -> None:
         self._state: dict[str, np.ndarray] | None = None
+        self._spare: dict[str, np.ndarray] | None = None  # arrays of a queue no longer valid
         self._synced_at = 0.0  # time (s) at which the particles were last written
         #: Events processed so far (collisions, wall hits, cell crossings, stale events).
         self.events = 0
@@ -360,7 +361,14 @@ class ExactCollisions:
         ncx, ncy = event_grid_shape(box.width, box.height, diameter, n)
         shared = _shared_radius_and_mass(particles)
         columns = events.BODY_COLUMNS if shared is None else events.SHARED_BODY_COLUMNS
-        s = _engine_arrays(n, ncx * ncy, columns)
+        # Arrays of the same shapes are filled again rather than allocated (with forces the queue
+        # is rebuilt at every substep).
+        old = self._state if self._state is not None else self._spare
+        self._spare = None
+        if old is not None and old["body"].shape == (n, columns) and old["head"].size == ncx * ncy:
+            s = old
+        else:
+            s = _engine_arrays(n, ncx * ncy, columns)
         s["geometry"] = np.array(
             [0.5 * box.width, 0.5 * box.height, box.width / ncx, box.height / ncy,
              *(shared or (np.nan, np.nan))]
@@ -411,7 +419,8 @@ class ExactCollisions:
             )
         self.events += processed
         if not math.isnan(halt[events.HALT_TIME]):
-            self._state = None  # part-way through the drift: rebuilt from the restored particles
+            # Part-way through the drift: rebuilt from the restored particles, in these arrays.
+            self._spare, self._state = self._state, None
             return Contact(
                 float(halt[events.HALT_TIME]),
                 int(halt[events.HALT_PARTICLE]),

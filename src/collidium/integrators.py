@@ -34,7 +34,7 @@ DEFAULT_TOLERANCE = 0.0007
 
 #: Most regular substeps in one reporting interval (a power of two); past it the interval is
 #: taken with this many and the energy check of the run reports the error.
-MAX_SUBSTEPS = 2**16
+MAX_SUBSTEPS = 2**14
 
 #: The energy scale of the substep criterion is the total energy, but at least ``KE + |U|``
 #: divided by this.
