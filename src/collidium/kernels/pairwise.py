@@ -203,11 +203,12 @@ def _stiffness_row(
         if periodic:
             dx -= width * round(dx / width)
             dy -= height * round(dy / height)
-        s2 = dx * dx + dy * dy + softening2
+        inverse = 1.0 / math.sqrt(dx * dx + dy * dy + softening2)  # one division a pair
         dvx = vx[c] - vx[j]
         dvy = vy[c] - vy[j]
-        u = k * abs(q[c] * q[j]) / math.sqrt(s2)
-        error = u * (dvx * dvx + dvy * dvy + u * (inverse_mass[c] + inverse_mass[j])) / s2
+        u = k * abs(q[c] * q[j]) * inverse
+        w2 = dvx * dvx + dvy * dvy
+        error = u * (w2 + u * (inverse_mass[c] + inverse_mass[j])) * inverse * inverse
         stiffness = max(stiffness, error * error)
     return stiffness
 
