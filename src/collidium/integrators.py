@@ -132,9 +132,11 @@ class AdaptiveLeapfrog:
     ``tolerance^2`` of it, a lone pair in a close approach counting in full and a close pair of a
     gas by its share of the gas's energy. An interval
     that turns out to need more substeps than it was given is taken again from its start with
-    more. The check covers both ends of every substep, so the choice is the same run forwards or
-    backwards (time-symmetric): the energy error stays bounded instead of drifting, and scales as
-    ``tolerance^2``.
+    more; the next interval starts from the same count, or half of it when half would have done.
+    Substeps are equal within an interval and the check covers both ends of each, so no substep
+    is sized from its start alone, which makes adaptive leapfrog drift: the scheme is
+    time-symmetric within an interval, and the count of an interval depends on its neighbours
+    only by that factor of two. The energy error stays bounded and scales as ``tolerance^2``.
 
     A contact under a force (a collision or a wall hit of a particle with an acceleration) would
     fall inside a drift, between the kicks, where the response cannot see the kick after it: the
