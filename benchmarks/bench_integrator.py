@@ -3,7 +3,7 @@
 I1  the seed's charged scenes at their defaults (dt = 0.01 s): wall seconds and the largest
     relative energy error ``max |E(t) - E(0)| / |E(0)|`` over every step, with the fixed and the
     adaptive integrator side by side (charged-gas, bohr-atom, charged-no-collisions, orbit,
-    charged-opposite).
+    charged-opposite, charged-like).
 I2  energy error against tolerance: the adaptive integrator on orbit and bohr-atom (20 s) at
     tolerances from 4e-3 down to the default; second order, so halving the tolerance quarters it.
 
@@ -23,7 +23,14 @@ from collidium.observers import EnergyDrift
 
 RESULTS = Path(__file__).parent / "results"
 
-SCENES = ("charged-gas", "bohr-atom", "charged-no-collisions", "orbit", "charged-opposite")
+SCENES = (
+    "charged-gas",
+    "bohr-atom",
+    "charged-no-collisions",
+    "orbit",
+    "charged-opposite",
+    "charged-like",
+)
 TOLERANCES = (4e-3, 2e-3, 1e-3, DEFAULT_TOLERANCE)
 
 

@@ -89,6 +89,7 @@ def coulomb_stiffness(
     if size is not None:
         d -= size * np.round(d / size)
     s2 = np.einsum("ijk,ijk->ij", d, d) + softening2
+    np.fill_diagonal(s2, np.inf)  # no pair: U = 0 there
     w = v[:, None, :] - v[None, :, :]
     u = k * np.abs(q[:, None] * q[None, :]) / np.sqrt(s2)
     error = u * (np.einsum("ijk,ijk->ij", w, w) + u * (1 / m[:, None] + 1 / m[None, :])) / s2
