@@ -109,6 +109,11 @@ class Job:
             raise InputError("--checkpoint", "the trajectory and checkpoint files must differ")
 
     @property
+    def drift_limit(self) -> float:
+        """The relative energy drift past which the run warns, or fails with ``max_drift``."""
+        return DRIFT_WARNING if self.max_drift is None else self.max_drift
+
+    @property
     def trajectory(self) -> Path | None:
         """The GSD file frames go to (a hidden one beside ``out`` for .xyz output)."""
         if self.out is None:
@@ -300,18 +305,17 @@ def summarise(
 def drift_exceeded(job: Job) -> bool:
     """Whether the run's energy drifted past its limit (``max_drift``, else `DRIFT_WARNING`).
     A drift that cannot be measured (a zero initial energy) never counts."""
-    limit = DRIFT_WARNING if job.max_drift is None else job.max_drift
-    return math.isfinite(job.max_rel_drift) and job.max_rel_drift > limit
+    return math.isfinite(job.max_rel_drift) and job.max_rel_drift > job.drift_limit
 
 
 def drift_warning(job: Job) -> str | None:
     """One line saying that the energy drifted past the run's limit, or None."""
     if not drift_exceeded(job):
         return None
-    limit = DRIFT_WARNING if job.max_drift is None else job.max_drift
     return (
         f"the total energy drifted by {job.max_rel_drift:.3g} of its initial value (limit "
-        f"{limit:g}): try a smaller run.tolerance, or a smaller dt with the fixed integrator"
+        f"{job.drift_limit:g}): try a smaller run.tolerance, or a smaller dt with the fixed "
+        "integrator"
     )
 
 

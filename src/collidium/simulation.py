@@ -84,8 +84,9 @@ class Simulation:
     forces : sequence of Coulomb, optional
         Forces between particles; none for a free (hard-disk) gas.
     dt : float
-        Time step in s (> 0). Without forces and with exact collisions it is only the interval
-        between reports: the motion is exact whatever its value.
+        Time step in s (> 0), the interval between reports. Without forces and with exact
+        collisions the motion is exact whatever its value; with forces the adaptive integrator
+        takes substeps inside it.
     collisions : {"exact", "step", "off"}
         Collision handling, see `collidium.collisions`.
     integrator : {"adaptive", "fixed"}
@@ -94,7 +95,7 @@ class Simulation:
         seed's scheme). The same without forces.
     tolerance : float
         The adaptive integrator's accuracy parameter (> 0): the largest substep as a fraction of
-        the fastest pair time scale.
+        the forces' fastest time scale, weighted by energy (`collidium.integrators`).
     seed : int, optional
         Seed of the simulation's random generator (`rng`).
     name : str, optional
@@ -375,11 +376,11 @@ class Simulation:
         # A value all particles share is saved once, and comes back shared.
         properties = {name: np.asarray(as_given(getattr(p, name))) for name in PROPERTIES}
         drift = {f"drift/{key}": value for key, value in self._drift.state().items()}
-        drift |= {f"integrator/{key}": value for key, value in self._integrator.state().items()}
+        integrator = {f"integrator/{k}": v for k, v in self._integrator.state().items()}
         arrays = {
             "position": p.position, "velocity": p.velocity, "image": p.image,
             "tally/counts": self.tally.counts, "tally/impulse": self.tally.impulse,
-        } | properties | drift  # fmt: skip
+        } | properties | drift | integrator  # fmt: skip
         box = self.container
         state = {
             "name": self.name,
