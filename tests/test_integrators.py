@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 import collidium as cd
+from collidium.collisions import Contact
 from collidium.errors import InputError
-from collidium.integrators import DEFAULT_TOLERANCE, AdaptiveLeapfrog
+from collidium.integrators import CONTACT_MARGIN, DEFAULT_TOLERANCE, AdaptiveLeapfrog, _shortened
 from collidium.observers import EnergyDrift
 
 
@@ -61,6 +62,39 @@ def test_contacts_under_forces_fall_between_substeps():
     inside = cd.load("charged-gas")
     inside._integrator = ContactsInsideDrifts(DEFAULT_TOLERANCE)
     assert max_drift(inside, 2.0) > 4.0 * between
+
+
+def test_a_periodic_charged_gas_holds_its_energy():
+    fixed = cd.load("charged-gas", boundary="periodic", n=100, integrator="fixed")
+    adaptive = cd.load("charged-gas", boundary="periodic", n=100)
+    assert max_drift(fixed, 1.0) > 1e-4
+    assert max_drift(adaptive, 1.0) <= 1e-5
+    assert adaptive.counters.pair_collisions > 100 and adaptive.escaped() == 0
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_shortened_substep_ends_at_the_contact_on_the_parabola(periodic):
+    """Two disks closing at 2 m/s and pulled together at 1 m/s^2, 0.8 m apart (across the edge of
+    a periodic box, or in the middle of a walled one): the kick-drift-kick parabola
+    ``0.8 - 2 h - h^2 / 2`` reaches the contact distance 0.5 m at ``h = sqrt(4.6) - 2``."""
+    x0 = 4.6 if periodic else -0.4
+    box = cd.Box(10, 10, boundary="periodic" if periodic else "reflecting")
+    particles = cd.Particles([[x0, 0.0], [x0 + 0.8 - (10.0 if periodic else 0.0), 0.0]],
+                             [[1.0, 0.0], [-1.0, 0.0]], radius=0.25)  # fmt: skip
+    acceleration = np.array([[0.5, 0.0], [-0.5, 0.0]])
+    straight = 0.15  # roughly where the drift, on straight paths, found the contact
+    h = _shortened(particles, box, acceleration, Contact(straight, 0, 1), 0.0, 0.2, 0.01)
+    assert h == pytest.approx(math.sqrt(4.6) - 2.0 - CONTACT_MARGIN * 0.01, abs=1e-15)
+
+
+def test_shortened_substep_ends_at_a_wall_on_the_parabola():
+    """A disk 0.5 m from the right wall's contact line, at 1 m/s, pushed at 2 m/s^2: it reaches
+    it at ``h^2 + h = 0.5``."""
+    particles = cd.Particles([[4.25, 0.0]], [[1.0, 0.0]], radius=0.25)
+    acceleration = np.array([[2.0, 0.0]])
+    right = -1 - 1  # -1 - wall, wall 1 the right one
+    h = _shortened(particles, cd.Box(10, 10), acceleration, Contact(0.4, 0, right), 0.0, 1.0, 0.01)
+    assert h == pytest.approx((math.sqrt(3.0) - 1.0) / 2.0 - CONTACT_MARGIN * 0.01, abs=1e-15)
 
 
 def test_halving_the_tolerance_quarters_the_error():
