@@ -1,4 +1,5 @@
-"""Presets: the exact parameters of DESIGN.md section 3, overrides, the registry."""
+"""Presets: the exact parameters of each seed configuration (as each preset's docstring states
+them), overrides, the registry."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """How particles move during the drift of a step, and how they collide.
 
-Three modes (DESIGN.md section 2):
+Three modes:
 
 - `ExactCollisions` (``"exact"``): event-driven free flight with exact elastic pair and wall
   collisions (`kernels/events.py`). Its event queue is kept between steps and rebuilt only when the

@@ -1,4 +1,4 @@
-"""The seed report's configurations as scenarios (DESIGN.md section 3).
+"""The seed report's configurations as scenarios: one small builder per preset, registered by name.
 
 Default vessel: a 20 m x 20 m reflecting box centred on the origin; m = 1 kg, r = 0.25 m,
 k = 5 N m^2/C^2, dt = 0.01 s, seed 1, run time 10 s (pool-break: 60 s), unless a preset says

@@ -1,4 +1,4 @@
-"""GSD trajectories (DESIGN.md section 5) and extended-XYZ export.
+"""GSD trajectories in the HOOMD schema and extended-XYZ export.
 
 A frame holds the HOOMD schema that OVITO, MDAnalysis and freud read: a 2D box
 ``[Lx, Ly, 0, 0, 0, 0]`` centred on the origin, positions (N, 3) with z = 0, velocities, masses,
