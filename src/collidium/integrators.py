@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Literal, Protocol
+from typing import Literal
 
 import numpy as np
 
@@ -50,10 +50,23 @@ CONTACT_WINDOW = 1e-8
 CONTACT_MARGIN = 1e-10
 
 
-class Integrator(Protocol):
-    """Advances the state over one reporting interval."""
+class Integrator:
+    """Advances the state over one reporting interval: the common part of the integrators.
+
+    Without forces every integrator is the same single drift (the exact engine's queue then
+    survives from step to step); with forces `step` hands over to `_with_forces`.
+
+    Parameters
+    ----------
+    tolerance : float
+        The adaptive integrator's accuracy parameter; the fixed step keeps it, unused, so that
+        switching back restores it.
+    """
 
     name: IntegratorName
+
+    def __init__(self, tolerance: float = DEFAULT_TOLERANCE) -> None:
+        self.tolerance = float(tolerance)
 
     def step(
         self,
@@ -70,32 +83,12 @@ class Integrator(Protocol):
         The acceleration of the current positions must be in the field's cache: `ForceField`
         evaluates it once before the first step, and the integrator keeps it current.
         """
+        if field.active:
+            self._with_forces(particles, box, field, drift, now, dt, tally)
+        else:
+            drift.drift(particles, box, now, dt, tally)
 
-    def state(self) -> dict[str, np.ndarray]:
-        """Arrays a checkpoint needs to continue bit for bit."""
-
-    def load_state(self, arrays: dict[str, np.ndarray]) -> None:
-        """Take back what `state` returned."""
-
-
-def make_integrator(name: IntegratorName, tolerance: float) -> Integrator:
-    """The integrator of a name, with its tolerance (unused by ``"fixed"``)."""
-    return AdaptiveLeapfrog(tolerance) if name == "adaptive" else Leapfrog()
-
-
-class Leapfrog:
-    """Velocity Verlet in kick-drift-kick form, one step of the reporting interval.
-
-    ``v += a dt/2``; drift for dt (free flight with collisions, exact or not); ``a = F(x)/m``;
-    ``v += a dt/2``. With exact collisions this is a Strang splitting of the hard-disk flow and the
-    soft forces: collisions conserve energy exactly, the soft forces have a bounded O(dt^2) error,
-    and each collision under a force adds an O(dt^2) error (the kicks are applied at the step's
-    ends, not at the collision). Without forces the kicks are skipped.
-    """
-
-    name: IntegratorName = "fixed"
-
-    def step(
+    def _with_forces(
         self,
         particles: Particles,
         box: Box,
@@ -105,23 +98,49 @@ class Leapfrog:
         dt: float,
         tally: Tally,
     ) -> None:
-        """Advance ``particles`` in place from time ``now`` by ``dt`` (s)."""
-        if not field.active:
-            drift.drift(particles, box, now, dt, tally)
-            return
+        raise NotImplementedError
+
+    def state(self) -> dict[str, np.ndarray]:
+        """Arrays a checkpoint needs to continue bit for bit (none by default)."""
+        return {}
+
+    def load_state(self, arrays: dict[str, np.ndarray]) -> None:
+        """Take back what `state` returned."""
+
+
+def make_integrator(name: IntegratorName, tolerance: float) -> Integrator:
+    """The integrator of a name, with its tolerance (kept, unused, by ``"fixed"``)."""
+    return (AdaptiveLeapfrog if name == "adaptive" else Leapfrog)(tolerance)
+
+
+class Leapfrog(Integrator):
+    """Velocity Verlet in kick-drift-kick form, one step of the reporting interval.
+
+    ``v += a dt/2``; drift for dt (free flight with collisions, exact or not); ``a = F(x)/m``;
+    ``v += a dt/2``. With exact collisions this is a Strang splitting of the hard-disk flow and the
+    soft forces: collisions conserve energy exactly, the soft forces have a bounded O(dt^2) error,
+    and each collision under a force adds an O(dt^2) error (the kicks are applied at the step's
+    ends, not at the collision).
+    """
+
+    name: IntegratorName = "fixed"
+
+    def _with_forces(
+        self,
+        particles: Particles,
+        box: Box,
+        field: ForceField,
+        drift: Drift,
+        now: float,
+        dt: float,
+        tally: Tally,
+    ) -> None:
         particles.velocity += (0.5 * dt) * field.acceleration
         drift.drift(particles, box, now, dt, tally, field.acceleration)
         particles.velocity += (0.5 * dt) * field.evaluate(particles, box)
 
-    def state(self) -> dict[str, np.ndarray]:
-        """Nothing to save."""
-        return {}
 
-    def load_state(self, arrays: dict[str, np.ndarray]) -> None:
-        """Nothing to restore."""
-
-
-class AdaptiveLeapfrog:
+class AdaptiveLeapfrog(Integrator):
     """Kick-drift-kick with adaptive substeps inside the reporting interval.
 
     The interval ``dt`` is cut into ``n`` equal substeps, ``n`` a power of two, the smallest with
@@ -154,7 +173,7 @@ class AdaptiveLeapfrog:
     name: IntegratorName = "adaptive"
 
     def __init__(self, tolerance: float = DEFAULT_TOLERANCE) -> None:
-        self.tolerance = float(tolerance)
+        super().__init__(tolerance)
         #: Regular substeps the next interval starts with (it may take more).
         self.substeps = 1
 
@@ -174,7 +193,7 @@ class AdaptiveLeapfrog:
             return MAX_SUBSTEPS
         return max(1, 1 << math.ceil(math.log2(ratio))) if ratio > 1.0 else 1
 
-    def step(
+    def _with_forces(
         self,
         particles: Particles,
         box: Box,
@@ -184,10 +203,6 @@ class AdaptiveLeapfrog:
         dt: float,
         tally: Tally,
     ) -> None:
-        """Advance ``particles`` in place from time ``now`` by ``dt`` (s)."""
-        if not field.active:
-            drift.drift(particles, box, now, dt, tally)
-            return
         start = _Snapshot(particles, tally)
         n = max(self.substeps, self.needed(_squared_rate(particles, box, field), dt))
         while True:

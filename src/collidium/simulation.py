@@ -131,7 +131,6 @@ class Simulation:
             particles.position[...] = wrapped
         _check_placement(container, particles, collisions)
         self._setup(container, particles, forces, dt, collisions, seed, name)
-        self._tolerance = float(tolerance)
         self._integrator = make_integrator(integrator, tolerance)
 
     def _setup(
@@ -157,7 +156,6 @@ class Simulation:
         self._attached: list[Observer] = []  # observers already attached (by identity)
         self._field = ForceField(tuple(forces))
         self._drift = make_drift(collisions)
-        self._tolerance = DEFAULT_TOLERANCE
         self._integrator = make_integrator("adaptive", DEFAULT_TOLERANCE)
         self.tally = Tally()
 
@@ -209,12 +207,11 @@ class Simulation:
     @property
     def tolerance(self) -> float:
         """The adaptive integrator's accuracy parameter (kept, unused, by "fixed")."""
-        return self._tolerance
+        return self._integrator.tolerance
 
     @tolerance.setter
     def tolerance(self, value: float) -> None:
         _check_integrator(self.integrator, value)
-        self._tolerance = float(value)
         self._integrator = make_integrator(self.integrator, value)
 
     @property
@@ -448,7 +445,6 @@ def restore_with_meta(path: str | Path) -> tuple[Simulation, dict[str, Any]]:
         integrator, tolerance = state.get("integrator", "fixed"), state.get("tolerance")
         tolerance = DEFAULT_TOLERANCE if tolerance is None else tolerance
         _check_integrator(integrator, tolerance)
-        sim._tolerance = float(tolerance)
         sim._integrator = make_integrator(integrator, tolerance)
         sim._integrator.load_state(
             {k.removeprefix("integrator/"): v for k, v in arrays.items()
