@@ -16,6 +16,7 @@ from collidium import render
 from collidium.errors import InputError
 from collidium.io.trajectory import GSDWriter, Trajectory, read_trajectory
 from collidium.observers.speeds import SpeedHistogram
+from collidium.vessels import Box
 
 DPI = 40  # small pictures keep the movies fast
 TAB_BLUE = (31, 119, 180)
@@ -252,9 +253,7 @@ def one_disk(radius: float, charge: float) -> Trajectory:
     """Two frames of one particle at rest at (2, -1) m in a 20 m x 10 m box."""
     frames = 2
     return Trajectory(
-        width=20.0,
-        height=10.0,
-        periodic=False,
+        vessel=Box(20.0, 10.0),
         step=np.arange(frames),
         time=np.array([0.0, 0.1]),
         position=np.tile([[[2.0, -1.0]]], (frames, 1, 1)),

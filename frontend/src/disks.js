@@ -1,4 +1,4 @@
-// WebGL (regl) drawing of the vessel: the box, every disk in one draw call (round gl.POINTS
+// WebGL (regl) drawing of the vessel: its outline, every disk in one draw call (round gl.POINTS
 // sprites with a thin dark rim, sized from the radius; quads when a disk is larger than the GPU's
 // point size limit) and, when the server sends velocities, one gl.LINES call for the momentum
 // vectors. Buffers are reused between frames.
@@ -255,9 +255,10 @@ export function createDiskRenderer(canvas, viewport) {
   const positionBuffer = regl.buffer({ usage: "dynamic", type: "float", length: 8 });
   const styleBuffer = regl.buffer({ usage: "static", type: "float", length: 16 });
   const lineBuffer = regl.buffer({ usage: "dynamic", type: "float", length: 16 });
-  // Unit square corners, stretched to the box by a uniform.
-  const boxFill = regl.buffer([[-0.5, -0.5], [0.5, -0.5], [-0.5, 0.5], [0.5, 0.5]]);
-  const boxOutline = regl.buffer([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]]);
+  // The vessel's outline (m), as the server sends it: filled as a fan from its first corner
+  // (right for convex and star-shaped outlines) and stroked as a loop.
+  const vesselOutline = regl.buffer({ usage: "static", type: "float", length: 8 });
+  let outlineCorners = 0;
 
   const diskUniforms = {
     scale: regl.prop("scale"),
@@ -328,7 +329,7 @@ export function createDiskRenderer(canvas, viewport) {
     depth: { enable: false },
   });
 
-  let boundary = "reflecting";
+  let periodic = false;
 
   /** Prepares the per-particle buffers for a new scene; nothing is drawn until a frame comes. */
   function setScene(scene) {
@@ -337,7 +338,10 @@ export function createDiskRenderer(canvas, viewport) {
     masses = perParticle(scene.mass, n, 1);
     typicalRadius = sampledMedian(radii, medianScratch);
     largestRadius = radii.reduce((most, radius) => Math.max(most, radius), 0);
-    boundary = scene.box?.boundary ?? "reflecting";
+    periodic = Boolean(scene.vessel?.periodic);
+    const corners = Array.isArray(scene.vessel?.outline) ? scene.vessel.outline : [];
+    outlineCorners = corners.length;
+    vesselOutline({ usage: "static", type: "float", data: corners.length ? corners.flat() : [0, 0] });
     styles = buildStyles(radii, perParticle(scene.charge, n, 0));
     styleBuffer({ usage: "static", type: "float", data: styles });
     if (n !== capacity) reallocate(n);
@@ -389,11 +393,14 @@ export function createDiskRenderer(canvas, viewport) {
     regl.poll(); // picks up canvas size changes for the viewport
     regl.clear({ color: LETTERBOX });
     const scale = viewport.clipScale();
-    const stretch = [viewport.boxWidth, viewport.boxHeight];
+    const stretch = [1, 1];
     const dpr = viewport.pixelRatio;
-    drawFlat({ primitive: "triangle strip", positions: boxFill, count: 4, scale, stretch, colour: [1, 1, 1, 1] });
-    const outline = boundary === "periodic" ? [0.62, 0.62, 0.62, 1] : [0.2, 0.2, 0.2, 1];
-    drawFlat({ primitive: "line loop", positions: boxOutline, count: 4, scale, stretch, colour: outline });
+    if (outlineCorners > 2) {
+      const corners = { positions: vesselOutline, count: outlineCorners, scale, stretch };
+      drawFlat({ primitive: "triangle fan", ...corners, colour: [1, 1, 1, 1] });
+      const outline = periodic ? [0.62, 0.62, 0.62, 1] : [0.2, 0.2, 0.2, 1];
+      drawFlat({ primitive: "line loop", ...corners, colour: outline });
+    }
     if (count > 0) {
       drawDisks({
         count,

@@ -1,9 +1,10 @@
-// The vessel's world <-> screen mapping: the box (centred on the origin, y up) is letterboxed
-// into the canvas with its aspect ratio kept and a 2 px margin, so the outline stays visible.
+// The vessel's world <-> screen mapping: the smallest box centred on the origin (y up) that holds
+// the vessel's bounding box is letterboxed into the canvas with its aspect ratio kept and a 2 px
+// margin, so the outline stays visible.
 
 const MARGIN_CSS_PX = 2;
 
-/** A mutable viewport; `setBox` and `setCanvasSize` update it, the rest read it. */
+/** A mutable viewport; `setVessel` and `setCanvasSize` update it, the rest read it. */
 export function createViewport() {
   const view = {
     boxWidth: 20,
@@ -21,7 +22,11 @@ export function createViewport() {
     view.pixelsPerMetre = Math.max(1e-9, Math.min(usableWidth / view.boxWidth, usableHeight / view.boxHeight));
   }
 
-  view.setBox = (width, height) => {
+  /** Fits the view to `bounds`, the vessel's bounding box `[[xmin, ymin], [xmax, ymax]]` (m). */
+  view.setVessel = (bounds) => {
+    const [[x0, y0], [x1, y1]] = Array.isArray(bounds) ? bounds : [[-0.5, -0.5], [0.5, 0.5]];
+    const width = 2 * Math.max(Math.abs(x0), Math.abs(x1));
+    const height = 2 * Math.max(Math.abs(y0), Math.abs(y1));
     view.boxWidth = width > 0 ? width : 1;
     view.boxHeight = height > 0 ? height : 1;
     update();

@@ -42,8 +42,7 @@ function buildLayout(root) {
 }
 
 function describeScene(scene) {
-  const box = scene.box ?? {};
-  return `${scene.name}: ${scene.n} particles in a ${box.width} × ${box.height} m ${box.boundary ?? ""} box`;
+  return `${scene.name}: ${scene.n} particles in a ${scene.vessel?.description ?? "vessel"}`;
 }
 
 /** Mounts the viewer in `root`; returns `{ destroy(), hooks }` (hooks: the test hook object). */
@@ -227,7 +226,7 @@ export function mountViewer(root, transport) {
     state.drawnFrame = null;
     state.drag = null;
     state.warnedSize = false;
-    viewport.setBox(scene.box?.width, scene.box?.height);
+    viewport.setVessel(scene.vessel?.bounds);
     renderer.setScene(scene);
     trace.follow(null);
     energyPlot.clear();

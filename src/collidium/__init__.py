@@ -6,13 +6,13 @@
 """
 
 from collidium import observers
-from collidium.containers import Box
 from collidium.errors import InputError, SimulationError
 from collidium.forces import Coulomb
 from collidium.loading import load
 from collidium.presets import presets
 from collidium.simulation import Counters, Energy, Simulation, restore
 from collidium.state import Particles
+from collidium.vessels import Box
 
 __all__ = [
     "Box",

@@ -21,11 +21,11 @@ from typing import Literal, Protocol
 
 import numpy as np
 
-from collidium.containers import Box
 from collidium.errors import SimulationError
 from collidium.kernels import events, stepper, walls
 from collidium.kernels.cells import event_grid_shape
 from collidium.state import FloatArray, IntArray, Particles, as_given
+from collidium.vessels import Box
 
 CollisionMode = Literal["exact", "step", "off"]
 COLLISION_MODES: tuple[CollisionMode, ...] = ("exact", "step", "off")

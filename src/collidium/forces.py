@@ -9,11 +9,11 @@ from typing import Literal
 
 import numpy as np
 
-from collidium.containers import Box
 from collidium.errors import InputError
 from collidium.kernels import tree
 from collidium.kernels.pairwise import coulomb_direct, coulomb_stiffness
 from collidium.state import FloatArray, Particles
+from collidium.vessels import Box
 
 SumMethod = Literal["auto", "direct", "tree"]
 SUM_METHODS: tuple[SumMethod, ...] = ("auto", "direct", "tree")

@@ -20,9 +20,9 @@ from typing import Literal
 import numpy as np
 
 from collidium.collisions import Contact, Drift, Tally
-from collidium.containers import Box
 from collidium.forces import ForceField
 from collidium.state import FloatArray, Particles
+from collidium.vessels import Box
 
 IntegratorName = Literal["adaptive", "fixed"]
 INTEGRATORS: tuple[IntegratorName, ...] = ("adaptive", "fixed")

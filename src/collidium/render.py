@@ -20,7 +20,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
 from matplotlib.figure import Figure
-from matplotlib.patches import Rectangle
+from matplotlib.patches import Polygon, Rectangle
 
 from collidium.errors import InputError
 from collidium.io.atomic import replacing
@@ -300,21 +300,20 @@ class _MovieFigure:
 
     def _vessel(self, ax: Axes) -> None:
         t = self.trajectory
-        w, h = t.width, t.height
         ax.add_patch(
-            Rectangle(
-                (-w / 2, -h / 2),
-                w,
-                h,
+            Polygon(
+                t.vessel.outline(),
+                closed=True,
                 fill=False,
                 edgecolor="black",
                 linewidth=1.2,
                 linestyle="--" if t.periodic else "-",
             )
         )
-        margin = 0.02 * max(w, h)
-        ax.set_xlim(-w / 2 - margin, w / 2 + margin)
-        ax.set_ylim(-h / 2 - margin, h / 2 + margin)
+        (x0, y0), (x1, y1) = t.vessel.bounds
+        margin = 0.02 * max(x1 - x0, y1 - y0)
+        ax.set_xlim(x0 - margin, x1 + margin)
+        ax.set_ylim(y0 - margin, y1 + margin)
         ax.set_aspect("equal")
         ax.set_xlabel("x (m)")
         ax.set_ylabel("y (m)")

@@ -60,7 +60,6 @@ from pydantic import (
     field_validator,
 )
 
-from collidium.containers import Box
 from collidium.errors import InputError
 from collidium.forces import DEFAULT_THETA, Coulomb
 from collidium.initial import balanced_charges, random_positions, rhombus_rack, uniform_velocities
@@ -80,6 +79,7 @@ from collidium.observers import (
 )
 from collidium.simulation import Simulation, outside_detail, overlap_detail
 from collidium.state import FloatArray, Particles, uniform_or_each
+from collidium.vessels import Box
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]

@@ -24,7 +24,6 @@ from typing import Any
 import numpy as np
 
 from collidium.collisions import COLLISION_MODES, CollisionMode, Tally, make_drift
-from collidium.containers import OUTSIDE_TOLERANCE, Box
 from collidium.errors import InputError, SimulationError
 from collidium.forces import Coulomb, ForceField
 from collidium.integrators import (
@@ -34,13 +33,12 @@ from collidium.integrators import (
     IntegratorName,
     make_integrator,
 )
-from collidium.io.checkpoint import read_checkpoint, write_checkpoint
+from collidium.io.checkpoint import read_checkpoint, saved_vessel, write_checkpoint
 from collidium.kernels.audit import first_invalid
 from collidium.kernels.cells import first_overlap, grid_shape
 from collidium.observers.base import Observer
 from collidium.state import PROPERTIES, FloatArray, Particles, as_given
-
-WALL_NAMES = ("left", "right", "bottom", "top")
+from collidium.vessels import OUTSIDE_TOLERANCE, Box, Vessel, vessel_from_dict
 
 #: Most steps one `Simulation.run` call accepts (a guard against a mistyped time or dt).
 MAX_STEPS = 1e12
@@ -335,7 +333,8 @@ class Simulation:
     @property
     def counters(self) -> Counters:
         """Pair collisions and wall hits (per wall) since the start."""
-        hits = {name: int(self.tally.counts[1 + k]) for k, name in enumerate(WALL_NAMES)}
+        names = self.container.wall_names
+        hits = {name: int(self.tally.counts[1 + k]) for k, name in enumerate(names)}
         return Counters(int(self.tally.counts[0]), hits)
 
     def escaped(self) -> int:
@@ -381,7 +380,7 @@ class Simulation:
         box = self.container
         state = {
             "name": self.name,
-            "box": {"width": box.width, "height": box.height, "boundary": box.boundary},
+            "vessel": box.to_dict(),
             "forces": [force.to_dict() for force in self.forces],
             "dt": self._dt,
             "time_origin": list(self._time_origin),
@@ -428,14 +427,13 @@ def restore_with_meta(path: str | Path) -> tuple[Simulation, dict[str, Any]]:
     arrays, meta = read_checkpoint(path)
     try:
         state = meta["simulation"]
-        box = state["box"]
         particles = Particles(
             arrays["position"], arrays["velocity"], mass=arrays["mass"],
             radius=arrays["radius"], charge=arrays["charge"], image=arrays["image"],
         )  # fmt: skip
         forces = [Coulomb(**{k: v for k, v in f.items() if k != "type"}) for f in state["forces"]]
-        container = Box(box["width"], box["height"], box["boundary"])
-        _check_setup(container, particles, forces, state["dt"], state["collisions"])
+        vessel = vessel_from_dict(saved_vessel(state))
+        container = _check_setup(vessel, particles, forces, state["dt"], state["collisions"])
         sim = Simulation.__new__(Simulation)
         # The saved state may hold contacts at round-off distance (or the step method's
         # overlaps): it is taken as saved, without the placement checks of a new simulation.
@@ -489,13 +487,14 @@ def step_count(time: float | None, steps: int | None, dt: float) -> int:
 
 
 def _check_setup(
-    container: Box,
+    container: Vessel,
     particles: Particles,
     forces: Sequence[Coulomb],
     dt: float,
     collisions: str,
-) -> None:
-    if not isinstance(container, Box):
+) -> Box:
+    """Refuse a bad setup (one line naming the field); the vessel, which the engines take."""
+    if not isinstance(container, Box):  # the engines know the box alone so far
         raise InputError("container", f"must be a Box, got {type(container).__name__}")
     if not isinstance(particles, Particles):
         raise InputError("particles", f"must be Particles, got {type(particles).__name__}")
@@ -503,6 +502,7 @@ def _check_setup(
     _check_dt(dt)
     _check_mode(collisions)
     container.check_fits(particles.radius)
+    return container
 
 
 def _check_forces(forces: Sequence[Coulomb], container: Box) -> None:
@@ -537,10 +537,8 @@ def _check_dt(dt: float) -> None:
 def outside_detail(container: Box, particles: Particles, i: int) -> str:
     """Where particle i is and why that is outside the vessel (for error messages)."""
     x, y = particles.position[i]
-    return (
-        f"at ({x:g}, {y:g}) with radius {particles.radius[i]:g} is outside the "
-        f"{container.width:g} x {container.height:g} box (centred on 0, 0)"
-    )
+    radius = particles.radius[i]
+    return f"at ({x:g}, {y:g}) with radius {radius:g} is outside the {container.describe()}"
 
 
 def overlap_detail(container: Box, particles: Particles, i: int, j: int) -> str:

@@ -138,3 +138,22 @@ def test_other_npz_files_and_incomplete_checkpoints_are_refused(tmp_path):
     write_checkpoint(bad_value, arrays, {k: v for k, v in meta.items() if k != "format"})
     with pytest.raises(InputError, match="invalid mass"):
         cd.restore(bad_value)
+
+
+def test_the_vessel_is_saved_and_checkpoints_that_name_a_box_still_restore(tmp_path):
+    path = tmp_path / "run.ckpt"
+    sim = cd.load("gas", n=50, **{"box.boundary": "periodic"}).run(steps=5)
+    sim.save(path)
+    arrays, meta = read_checkpoint(path)
+    assert meta["simulation"]["vessel"] == {"shape": "box", **sim.container.parameters()}
+    assert describe_checkpoint(path)["vessel"] == sim.container.to_dict()
+    # Before vessels had shapes, checkpoints held the box's parameters under "box".
+    state = dict(meta["simulation"])
+    state["box"] = sim.container.parameters()
+    del state["vessel"]
+    write_checkpoint(path, arrays, {k: v for k, v in meta.items() if k != "format"}
+                     | {"simulation": state})  # fmt: skip
+    again = cd.restore(path)
+    assert again.container.to_dict() == sim.container.to_dict()
+    np.testing.assert_array_equal(again.run(steps=5).particles.position,
+                                  sim.run(steps=5).particles.position)  # fmt: skip

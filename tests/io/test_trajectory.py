@@ -176,3 +176,18 @@ def test_damaged_file_gives_one_clear_error(tmp_path, damage):
 def test_missing_file():
     with pytest.raises(InputError, match="no such file"):
         read_trajectory("does-not-exist.gsd")
+
+
+def test_the_vessel_is_logged_and_read_back_and_files_without_it_get_their_box(tmp_path):
+    sim, path = record(tmp_path, "gas", every=100, steps=100, width=30.0, height=20.0)
+    trajectory = read_trajectory(path)
+    assert trajectory.vessel.to_dict() == sim.container.to_dict()
+    assert describe_file(path)["vessel"] == {"shape": "box", "width": 30.0, "height": 20.0,
+                                             "boundary": "reflecting"}  # fmt: skip
+    # A file from another program has only the GSD box (periodic, as HOOMD's boxes are).
+    plain = tmp_path / "plain.gsd"
+    with gsd.hoomd.open(path) as frames, gsd.hoomd.open(plain, "w") as out:
+        frame = frames[0]
+        frame.log = {}
+        out.append(frame)
+    assert read_trajectory(plain).vessel.to_dict() == cd.Box(30.0, 20.0, "periodic").to_dict()

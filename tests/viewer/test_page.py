@@ -14,6 +14,7 @@ from collidium.presets import preset
 from collidium.scenario import Scenario
 
 GREY = np.array([0x7F, 0x7F, 0x7F])
+LETTERBOX = np.round(255 * np.array([0.91, 0.925, 0.945]))
 
 
 def readout(page, name: str) -> float:
@@ -52,6 +53,30 @@ def test_disks_are_drawn_to_scale_and_move(page):
     second = pixels(page, "#particles")
     moved = (grey_disk_pixels(first) != grey_disk_pixels(second)).sum()
     assert moved > 0.2 * drawn  # at ~10 m/s, most disks move by more than a radius in 0.5 s
+
+
+def test_the_vessel_is_drawn_from_the_outline_the_server_sends(page):
+    outline = page.evaluate("window.collidiumViewer.scene.vessel.outline")
+    assert outline == [[-10.0, -10.0], [10.0, -10.0], [10.0, 10.0], [-10.0, 10.0]]
+    image = pixels(page, "#particles")
+    height, width = image.shape[:2]
+    metre = (min(width, height) - 4) / 20.0
+    left, right = round(width / 2 - 10 * metre), round(width / 2 + 10 * metre)
+    top, bottom = round(height / 2 - 10 * metre), round(height / 2 + 10 * metre)
+    letterbox = (np.abs(image - LETTERBOX) <= 3).all(axis=2)
+    white = (image >= 250).all(axis=2)
+    dark = (image <= 80).all(axis=2)
+    # Outside the outline (2 px clear of it) only the letterbox; inside, white between disks.
+    outside = np.ones((height, width), dtype=bool)
+    outside[max(top - 2, 0) : bottom + 3, max(left - 2, 0) : right + 3] = False
+    outside[[0, -1], :] = outside[:, [0, -1]] = False  # the element's own edge
+    assert letterbox[outside].mean() > 0.99
+    assert white[top + 3 : bottom - 2, left + 3 : right - 2].mean() > 0.5
+    # The outline itself: dark along the edges (disks may hide a few of its pixels).
+    rows = slice(top + 3, bottom - 2)
+    for column in (left, right):
+        edge = dark[rows, max(column - 1, 0) : column + 2].any(axis=1)
+        assert edge.mean() > 0.9
 
 
 def test_plots_update(page):

@@ -18,6 +18,7 @@ import numpy as np
 
 from collidium.errors import InputError
 from collidium.io.atomic import replacing
+from collidium.vessels import vessel_from_dict
 
 FORMAT = "collidium-checkpoint"
 VERSION = 1
@@ -67,12 +68,20 @@ def read_checkpoint(path: str | Path) -> tuple[dict[str, np.ndarray], dict[str, 
     return arrays, meta
 
 
+def saved_vessel(state: dict[str, Any]) -> dict[str, Any]:
+    """The vessel's `Vessel.to_dict` in a checkpoint's simulation state; checkpoints from before
+    vessels had shapes hold a ``box``."""
+    return state["vessel"] if "vessel" in state else {"shape": "box", **state["box"]}
+
+
 def describe_checkpoint(path: str | Path) -> dict[str, Any]:
-    """What a checkpoint holds: the simulation's name, size, box, step, time and saved run."""
+    """What a checkpoint holds: the simulation's name, size, vessel (and its bounding box), step,
+    time and saved run."""
     path = Path(path)
     arrays, meta = read_checkpoint(path)
     try:
         state = meta["simulation"]
+        vessel = vessel_from_dict(saved_vessel(state))
         t0, k0 = state["time_origin"]
         return {
             "file": str(path),
@@ -80,8 +89,8 @@ def describe_checkpoint(path: str | Path) -> dict[str, Any]:
             "bytes": path.stat().st_size,
             "scenario": state["name"],
             "n": int(arrays["position"].shape[0]),
-            "box": [state["box"]["width"], state["box"]["height"]],
-            "boundary": state["box"]["boundary"],
+            "vessel": vessel.to_dict(),
+            "box": [float(side) for side in vessel.size],
             "collisions": state["collisions"],
             "forces": state["forces"],
             "step": state["steps"],

@@ -1,14 +1,16 @@
 """GSD trajectories in the HOOMD schema and extended-XYZ export.
 
 A frame holds the HOOMD schema that OVITO, MDAnalysis and freud read: a 2D box
-``[Lx, Ly, 0, 0, 0, 0]`` centred on the origin, positions (N, 3) with z = 0, velocities, masses,
-charges and diameters, a particle type per sign of the charge, and the observables under
-``log/`` (`LOG_KEYS`). Positions and velocities are stored in single precision, as the schema
+``[Lx, Ly, 0, 0, 0, 0]`` centred on the origin (the vessel's bounding box), positions (N, 3) with
+z = 0, velocities, masses, charges and diameters, a particle type per sign of the charge, and the
+observables under ``log/`` (`LOG_KEYS`), among them the vessel itself, so that readers redraw
+its real outline. Positions and velocities are stored in single precision, as the schema
 does by default; checkpoints (`collidium.io.checkpoint`) keep the exact state.
 """
 
 from __future__ import annotations
 
+import json
 import time as clock
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -21,6 +23,7 @@ from collidium.errors import InputError
 from collidium.io.atomic import replacing
 from collidium.observers.base import Trigger, as_trigger
 from collidium.state import FloatArray
+from collidium.vessels import Box, Vessel, vessel_from_dict
 
 if TYPE_CHECKING:
     import gsd.hoomd
@@ -35,6 +38,7 @@ LOG_KEYS = {
     "collidium/time": "simulated time, s",
     "collidium/dt": "time step, s",
     "collidium/periodic": "1 for a periodic box, 0 for reflecting walls",
+    "collidium/vessel": "the vessel as UTF-8 JSON bytes: its shape and parameters",
     "energy/kinetic": "kinetic energy, J",
     "energy/potential": "potential energy, J",
     "energy/total": "total energy, J",
@@ -47,6 +51,13 @@ LOG_KEYS = {
     "impulse/walls": "momentum received by the left, right, bottom, top wall, kg m/s",
     "virial/forces": "pair virial of the forces now, J",
 }
+
+
+def gsd_box(vessel: Vessel) -> tuple[float, float]:
+    """Sides ``(Lx, Ly)`` in m of the smallest box centred on the origin that holds the vessel
+    (the GSD box is centred on the origin)."""
+    reach = np.max(np.abs(vessel.bounds), axis=0)
+    return float(2.0 * reach[0]), float(2.0 * reach[1])
 
 
 def type_ids(charge: FloatArray) -> np.ndarray:
@@ -63,7 +74,8 @@ def frame_of(sim: Simulation) -> gsd.hoomd.Frame:
     frame = gsd.hoomd.Frame()
     frame.configuration.step = sim.steps
     frame.configuration.dimensions = 2
-    frame.configuration.box = [box.width, box.height, 0.0, 0.0, 0.0, 0.0]
+    width, height = gsd_box(box)
+    frame.configuration.box = [width, height, 0.0, 0.0, 0.0, 0.0]
     frame.particles.N = p.n
     frame.particles.types = list(TYPES)
     frame.particles.typeid = type_ids(p.charge)
@@ -80,6 +92,7 @@ def frame_of(sim: Simulation) -> gsd.hoomd.Frame:
         "collidium/time": sim.time,
         "collidium/dt": sim.dt,
         "collidium/periodic": int(box.periodic),
+        "collidium/vessel": np.frombuffer(json.dumps(box.to_dict()).encode(), dtype=np.uint8),
         "energy/kinetic": energy.kinetic,
         "energy/potential": energy.potential,
         "energy/total": energy.total,
@@ -206,10 +219,8 @@ class Trajectory:
 
     Attributes
     ----------
-    width, height : float
-        Box sides in m; the box is centred on the origin.
-    periodic : bool
-        Periodic box (else reflecting walls).
+    vessel : Vessel
+        The vessel the frames were taken in.
     step : ndarray of int64, shape (K,)
         Step of each frame.
     time : ndarray, shape (K,)
@@ -222,9 +233,7 @@ class Trajectory:
         Each ``log/`` entry (without the prefix) stacked over frames, shape (K, ...).
     """
 
-    width: float
-    height: float
-    periodic: bool
+    vessel: Vessel
     step: np.ndarray
     time: FloatArray
     position: FloatArray
@@ -233,6 +242,21 @@ class Trajectory:
     radius: FloatArray
     charge: FloatArray
     log: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def width(self) -> float:
+        """Side along x of the vessel's bounding box, m."""
+        return float(self.vessel.size[0])
+
+    @property
+    def height(self) -> float:
+        """Side along y of the vessel's bounding box, m."""
+        return float(self.vessel.size[1])
+
+    @property
+    def periodic(self) -> bool:
+        """Whether the vessel is periodic."""
+        return self.vessel.periodic
 
     @property
     def frames(self) -> int:
@@ -293,11 +317,8 @@ def read_trajectory(path: str | Path) -> Trajectory:
     }
     step = np.array([int(f.configuration.step) for f in frames], dtype=np.int64)
     time = log["collidium/time"][:, 0] if "collidium/time" in log else step.astype(float)
-    periodic = bool(log["collidium/periodic"][0, 0]) if "collidium/periodic" in log else True
     return Trajectory(
-        width=float(first.configuration.box[0]),
-        height=float(first.configuration.box[1]),
-        periodic=periodic,
+        vessel=_vessel_of(path, first, log),
         step=step,
         time=np.asarray(time, dtype=float),
         position=np.stack([f.particles.position[:, :2] for f in frames]).astype(float),
@@ -322,6 +343,19 @@ def keep_frames_through(path: str | Path, step: int) -> int:
     return len(kept)
 
 
+def _vessel_of(path: Path, first: gsd.hoomd.Frame, log: dict[str, np.ndarray]) -> Vessel:
+    """The vessel logged in a file, or for files without one (other programs, older versions)
+    the GSD box, periodic unless logged as reflecting."""
+    if "collidium/vessel" in log:
+        try:
+            return vessel_from_dict(json.loads(log["collidium/vessel"][0].tobytes().decode()))
+        except (ValueError, TypeError, InputError) as exc:
+            raise InputError(str(path), f"the logged vessel cannot be read ({exc})") from None
+    periodic = bool(log["collidium/periodic"][0, 0]) if "collidium/periodic" in log else True
+    width, height = (float(side) for side in first.configuration.box[:2])
+    return Box(width, height, "periodic" if periodic else "reflecting")
+
+
 def write_xyz(trajectory: Trajectory, path: str | Path) -> None:
     """Write an extended-XYZ file (one block per frame; OVITO and ASE read it).
 
@@ -329,7 +363,7 @@ def write_xyz(trajectory: Trajectory, path: str | Path) -> None:
     ``Time`` and ``pbc``, then one line per particle: type, x, y, z, vx, vy, vz, mass, radius,
     charge.
     """
-    w, h = trajectory.width, trajectory.height
+    (x0, y0), (w, h) = trajectory.vessel.bounds[0], trajectory.vessel.size
     pbc = "T T F" if trajectory.periodic else "F F F"
     names = np.array(TYPES)[type_ids(trajectory.charge)]
     zeros = np.zeros(trajectory.n)
@@ -337,7 +371,7 @@ def write_xyz(trajectory: Trajectory, path: str | Path) -> None:
     for k in range(trajectory.frames):
         lines.append(str(trajectory.n))
         lines.append(
-            f'Lattice="{w:.17g} 0 0 0 {h:.17g} 0 0 0 1" Origin="{-w / 2:.17g} {-h / 2:.17g} -0.5" '
+            f'Lattice="{w:.17g} 0 0 0 {h:.17g} 0 0 0 1" Origin="{x0:.17g} {y0:.17g} -0.5" '
             "Properties=species:S:1:pos:R:3:velo:R:3:mass:R:1:radius:R:1:charge:R:1 "
             f'Time={trajectory.time[k]:.17g} Step={int(trajectory.step[k])} pbc="{pbc}"'
         )
@@ -362,8 +396,8 @@ def describe(path: str | Path) -> dict[str, Any]:
         "bytes": path.stat().st_size,
         "frames": trajectory.frames,
         "n": trajectory.n,
+        "vessel": trajectory.vessel.to_dict(),
         "box": [trajectory.width, trajectory.height],
-        "boundary": "periodic" if trajectory.periodic else "reflecting",
         "steps": [int(trajectory.step[0]), int(trajectory.step[-1])],
         "time": [float(trajectory.time[0]), float(trajectory.time[-1])],
         "types": {t: int(np.sum(type_ids(trajectory.charge) == k)) for k, t in enumerate(TYPES)},

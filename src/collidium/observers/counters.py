@@ -7,7 +7,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from collidium.observers.base import Measurement, Trigger, new_axes
-from collidium.observers.thermo import WALLS
 from collidium.state import FloatArray
 
 if TYPE_CHECKING:
@@ -34,6 +33,8 @@ class CollisionRate(Measurement):
     def _start(self, sim: Simulation) -> None:
         self._time, self._counts, self._mean_speed = [], [], []
         self.n = sim.particles.n
+        #: The vessel's walls, in the order of the wall counters.
+        self.walls = sim.container.wall_names
 
     def _sample(self, sim: Simulation) -> None:
         self._time.append(sim.time)
@@ -53,7 +54,7 @@ class CollisionRate(Measurement):
 
     def _gained(self) -> tuple[np.ndarray, float]:
         if len(self._time) < 2:
-            return np.zeros(5, dtype=np.int64), 0.0
+            return np.zeros(1 + len(self.walls), dtype=np.int64), 0.0
         return self._counts[-1] - self._counts[0], self._time[-1] - self._time[0]
 
     @property
@@ -67,7 +68,7 @@ class CollisionRate(Measurement):
         """Hits per second on each wall."""
         gained, duration = self._gained()
         return {w: float(gained[1 + k] / duration) if duration > 0 else float("nan")
-                for k, w in enumerate(WALLS)}  # fmt: skip
+                for k, w in enumerate(self.walls)}  # fmt: skip
 
     @property
     def mean_free_time(self) -> float:

@@ -2,10 +2,11 @@
 
 Boltzmann's constant is 1, so temperatures are kT in J; in 2D pressure is a force per unit length
 (N/m). With hard walls, a disk of radius r touches a wall when its centre is r away from it, so
-the centres move in the box shrunk by the mean radius on each side: the wall pressure is the
-force per unit length of that line of contact, and the virial pressure uses the area it encloses,
+the centres move in the vessel shrunk by the mean radius r: the wall pressure of a wall is the
+normal force on it per unit length of its line of contact (`Vessel.contact_lengths`), and the
+virial pressure uses the area that line encloses (`Vessel.available_area`; for a box
+``A_c = (Lx - 2 r) (Ly - 2 r)``, ``Lx Ly`` when periodic),
 
-    A_c = (Lx - 2 r) (Ly - 2 r)         (Lx Ly in a periodic box),
     P_virial = (N kT + W / 2) / A_c,    W = <sum_{i<j} r_ij . F_ij> (collisions and forces).
 
 With these definitions the two agree exactly on average in equilibrium (for equal radii: the
@@ -25,8 +26,6 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
     from collidium.simulation import Simulation
-
-WALLS = ("left", "right", "bottom", "top")
 
 #: Most blocks the samples are grouped into for the statistical errors.
 MAX_BLOCKS = 20
@@ -73,14 +72,15 @@ class Thermo(Measurement):
     def _start(self, sim: Simulation) -> None:
         self._time, self._kT, self._impulse, self._force_virial = [], [], [], []
         self.n = sim.particles.n
-        box = sim.container
-        walled = not box.periodic and self.n > 0
-        inset = 2.0 * float(np.mean(sim.particles.radius)) if walled else 0.0
-        self.periodic = box.periodic
-        #: Lengths (m) of the lines of contact of the left/right and of the bottom/top walls.
-        self.contact = (box.height - inset, box.width - inset)
+        vessel = sim.container
+        radius = float(np.mean(sim.particles.radius)) if self.n > 0 else 0.0
+        self.periodic = vessel.periodic
+        #: The vessel's walls, in the order of the wall counters.
+        self.walls = vessel.wall_names
+        #: Length (m) of each wall's line of contact for disks of the mean radius.
+        self.contact = vessel.contact_lengths(radius)
         #: Area (m^2) the centres move in.
-        self.area = (box.width - inset) * (box.height - inset)
+        self.area = vessel.available_area(radius)
 
     def _sample(self, sim: Simulation) -> None:
         self._time.append(sim.time)
@@ -112,8 +112,7 @@ class Thermo(Measurement):
     def _wall_values(self) -> tuple[FloatArray, FloatArray]:
         """Wall pressure per interval (total) and the intervals' durations."""
         dt, impulse, _, _ = self._intervals()
-        perimeter = 2.0 * (self.contact[0] + self.contact[1])
-        return impulse[:, 1:].sum(axis=1) / (dt * perimeter), dt
+        return impulse[:, 1:].sum(axis=1) / (dt * float(np.sum(self.contact))), dt
 
     def _virial_values(self) -> tuple[FloatArray, FloatArray]:
         """Virial pressure per interval and the intervals' durations."""
@@ -125,12 +124,11 @@ class Thermo(Measurement):
         """Force per unit length of contact line on each wall and on all together, N/m
         (NaN in a periodic box or without samples)."""
         if self.periodic or self.duration <= 0:
-            return {name: float("nan") for name in (*WALLS, "total")}
+            return {name: float("nan") for name in (*self.walls, "total")}
         gained = self._impulse[-1] - self._impulse[0]
-        lengths = (self.contact[0], self.contact[0], self.contact[1], self.contact[1])
-        out = {name: float(gained[1 + k] / (self.duration * lengths[k]))
-               for k, name in enumerate(WALLS)}  # fmt: skip
-        out["total"] = float(gained[1:].sum() / (self.duration * 2 * sum(self.contact)))
+        out = {name: float(gained[1 + k] / (self.duration * self.contact[k]))
+               for k, name in enumerate(self.walls)}  # fmt: skip
+        out["total"] = float(gained[1:].sum() / (self.duration * float(np.sum(self.contact))))
         return out
 
     def wall_pressure_error(self) -> float:
@@ -183,7 +181,7 @@ class Thermo(Measurement):
             "pressure": {
                 "wall": None if self.periodic else wall["total"],
                 "wall_error": None if self.periodic else self.wall_pressure_error(),
-                "walls": None if self.periodic else {k: wall[k] for k in WALLS},
+                "walls": None if self.periodic else {k: wall[k] for k in self.walls},
                 "virial": self.virial_pressure(),
                 "virial_error": self.virial_pressure_error(),
             },

@@ -270,11 +270,15 @@ class ViewerSession:
         """The vessel and what each particle looks like."""
         sim = self.sim
         p = sim.particles
-        box = sim.container
+        vessel = sim.container
         return {
             "type": "scene", "generation": self.generation, "name": sim.name,
             "preset": self._preset, "overrides": self._overrides, "n": p.n,
-            "box": {"width": box.width, "height": box.height, "boundary": box.boundary},
+            "vessel": vessel.to_dict() | {
+                "description": vessel.describe(), "periodic": vessel.periodic,
+                "outline": vessel.outline().tolist(), "bounds": vessel.bounds.tolist(),
+                "walls": list(vessel.wall_names),
+            },
             "radius": _compact(p.radius), "charge": _compact(p.charge),
             "mass": _compact(p.mass), "dt": sim.dt, "collisions": self._mode,
             "has_charges": bool(self._forces) and bool(np.any(p.charge != 0)),

@@ -1,4 +1,4 @@
-"""Vessels. `Box`: a rectangle centred on the origin, reflecting or periodic.
+"""`Box`: a rectangle centred on the origin, reflecting or periodic.
 
 The geometry lives here; the fast time-of-impact and reflection arithmetic used inside a run is in
 `kernels/walls.py` (and the event engine), which take the half sizes this class provides.
@@ -6,21 +6,22 @@ The geometry lives here; the fast time-of-impact and reflection arithmetic used 
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 
 from collidium.errors import InputError
 from collidium.state import FloatArray, IntArray
+from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
 
 Boundary = Literal["reflecting", "periodic"]
 BOUNDARIES: tuple[Boundary, ...] = ("reflecting", "periodic")
 
-#: Relative round-off allowance when deciding that a disk pokes out of a reflecting box.
-OUTSIDE_TOLERANCE = 1e-9
+#: The walls of a reflecting box, in the order of the wall counters.
+WALLS = ("left", "right", "bottom", "top")
 
 
-class Box:
+class Box(Vessel):
     """Rectangle ``[-width/2, width/2] x [-height/2, height/2]`` in m.
 
     Parameters
@@ -31,8 +32,10 @@ class Box:
         ``"reflecting"``: walls reflect disks elastically at the exact time of impact (a disk of
         radius r touches a wall when its centre is r away from it). ``"periodic"``: positions wrap,
         pairs and forces use the minimum image, unwrapped displacements are kept in
-        ``Particles.image``.
+        ``Particles.image``; it has no walls.
     """
+
+    kind: ClassVar[str] = "box"
 
     def __init__(self, width: float, height: float, boundary: Boundary = "reflecting") -> None:
         for name, value in (("width", width), ("height", height)):
@@ -50,6 +53,17 @@ class Box:
         return self.boundary == "periodic"
 
     @property
+    def wall_names(self) -> tuple[str, ...]:
+        """``("left", "right", "bottom", "top")``; none in a periodic box."""
+        return () if self.periodic else WALLS
+
+    @property
+    def bounds(self) -> FloatArray:
+        """``[[-width/2, -height/2], [width/2, height/2]]`` in m."""
+        half = 0.5 * self.size
+        return np.array([-half, half])
+
+    @property
     def size(self) -> FloatArray:
         """``(width, height)`` in m, shape (2,)."""
         return np.array([self.width, self.height])
@@ -59,22 +73,32 @@ class Box:
         """Area in m^2."""
         return self.width * self.height
 
+    def outline(self) -> FloatArray:
+        """The four corners, counter-clockwise from the bottom left, in m, shape (4, 2)."""
+        (x0, y0), (x1, y1) = self.bounds
+        return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+
+    def _inset(self, radius: float) -> float:
+        """How much shorter each side is for the centres of disks of ``radius``: 2 r with walls."""
+        return 0.0 if self.periodic else 2.0 * radius
+
+    def available_area(self, radius: float) -> float:
+        """``(width - 2 r) (height - 2 r)`` in m^2 (the whole area in a periodic box)."""
+        inset = self._inset(radius)
+        return (self.width - inset) * (self.height - inset)
+
+    def contact_lengths(self, radius: float) -> FloatArray:
+        """Left and right walls ``height - 2 r``, bottom and top ``width - 2 r``, in m (none in a
+        periodic box)."""
+        if self.periodic:
+            return np.empty(0)
+        inset = self._inset(radius)
+        side, across = self.height - inset, self.width - inset
+        return np.array([side, side, across, across])
+
     def outside(self, position: FloatArray, radius: FloatArray) -> IntArray:
-        """Indices of particles not inside the vessel.
-
-        Parameters
-        ----------
-        position : ndarray, shape (N, 2)
-            Centres in m.
-        radius : ndarray, shape (N,)
-            Radii in m.
-
-        Returns
-        -------
-        ndarray of int, shape (M,)
-            Reflecting box: disks that reach past a wall by more than round-off. Periodic box:
-            centres outside the primary cell ``[-L/2, L/2]``.
-        """
+        """`Vessel.outside`: in a reflecting box, disks that reach past a wall by more than
+        round-off; in a periodic box, centres outside the primary cell ``[-L/2, L/2]``."""
         half = 0.5 * self.size
         if self.periodic:
             reach = np.abs(position) - half
@@ -113,8 +137,13 @@ class Box:
         size = self.size
         return displacement - size * np.round(displacement / size)
 
-    def to_dict(self) -> dict[str, object]:
-        """Plain parameters, as in a scenario file."""
+    def describe(self) -> str:
+        """``'20 x 10 box (centred on 0, 0)'``, with ``periodic`` when it is."""
+        periodic = "periodic " if self.periodic else ""
+        return f"{self.width:g} x {self.height:g} {periodic}box (centred on 0, 0)"
+
+    def parameters(self) -> dict[str, Any]:
+        """``{"width", "height", "boundary"}``, as in a scenario file."""
         return {"width": self.width, "height": self.height, "boundary": self.boundary}
 
     def __repr__(self) -> str:

@@ -1,0 +1,30 @@
+"""Vessels: the containers the disks move in, one module per shape.
+
+Every shape is a `Vessel` (`base.py`): it answers the geometry that placement, the audit, the
+observers, the files and the views need (inside test, outline, area open to centres, named walls
+and their contact lengths, bounding box). Adding a shape means adding its module and registering
+its class in `VESSELS`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from collidium.errors import InputError
+from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
+from collidium.vessels.box import Box
+
+#: Vessel classes by their `Vessel.kind` (the ``shape`` of a scenario file or checkpoint).
+VESSELS: dict[str, type[Vessel]] = {cls.kind: cls for cls in (Box,)}
+
+
+def vessel_from_dict(data: dict[str, Any]) -> Vessel:
+    """The vessel of `Vessel.to_dict`'s output: ``{"shape": kind, **parameters}``."""
+    parameters = dict(data)
+    shape = parameters.pop("shape", "box")
+    if shape not in VESSELS:
+        raise InputError("vessel.shape", f"must be one of {tuple(VESSELS)}, got {shape!r}")
+    return VESSELS[shape](**parameters)
+
+
+__all__ = ["OUTSIDE_TOLERANCE", "VESSELS", "Box", "Vessel", "vessel_from_dict"]

@@ -1,0 +1,109 @@
+"""What every vessel answers: the geometry that placement, the audit, the observers, the files and
+the views ask for, so that none of them knows a shape."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from typing import Any, ClassVar
+
+import numpy as np
+
+from collidium.state import FloatArray, IntArray
+
+#: Relative round-off allowance when deciding that a disk pokes out of a vessel.
+OUTSIDE_TOLERANCE = 1e-9
+
+
+class Vessel(ABC):
+    """A 2D container of disks, with named walls.
+
+    A shape is one module of this package: a subclass registered in `collidium.vessels.VESSELS`
+    under its `kind`, with its fast arithmetic in a kernel file of its own.
+    """
+
+    #: The shape's name in scenario files and checkpoints (``shape: box``).
+    kind: ClassVar[str]
+
+    @property
+    def periodic(self) -> bool:
+        """True when positions wrap around instead of meeting walls."""
+        return False
+
+    @property
+    @abstractmethod
+    def wall_names(self) -> tuple[str, ...]:
+        """The walls, in the order of the wall counters (`collidium.collisions.Tally`); empty
+        when the vessel has none (periodic)."""
+
+    @property
+    @abstractmethod
+    def bounds(self) -> FloatArray:
+        """The bounding box ``[[x_min, y_min], [x_max, y_max]]`` in m, shape (2, 2)."""
+
+    @property
+    def size(self) -> FloatArray:
+        """Sides of the bounding box ``(width, height)`` in m, shape (2,)."""
+        low, high = self.bounds
+        return high - low
+
+    @property
+    @abstractmethod
+    def area(self) -> float:
+        """Area enclosed, m^2."""
+
+    @abstractmethod
+    def outline(self) -> FloatArray:
+        """Corners of the boundary, counter-clockwise, in m, shape (M, 2): what a view draws
+        (a curved wall comes as a fine polygon)."""
+
+    @abstractmethod
+    def available_area(self, radius: float) -> float:
+        """Area in m^2 that the centres of disks of ``radius`` m can reach."""
+
+    @abstractmethod
+    def contact_lengths(self, radius: float) -> FloatArray:
+        """Length in m of each wall's line of contact for disks of ``radius`` m: the line their
+        centres are on when they touch it, by wall (`wall_names` order), shape (W,). The wall
+        pressure is the normal impulse per unit time per unit of it."""
+
+    @abstractmethod
+    def outside(self, position: FloatArray, radius: FloatArray) -> IntArray:
+        """Indices of the disks not inside the vessel.
+
+        Parameters
+        ----------
+        position : ndarray, shape (N, 2)
+            Centres in m.
+        radius : ndarray, shape (N,)
+            Radii in m.
+
+        Returns
+        -------
+        ndarray of int, shape (M,)
+            Disks that reach past a wall by more than round-off, or whose centre is not finite.
+        """
+
+    @abstractmethod
+    def check_fits(self, radius: FloatArray) -> None:
+        """Refuse (`collidium.errors.InputError`) disks too large for the vessel."""
+
+    @abstractmethod
+    def describe(self) -> str:
+        """The vessel in words, for messages: ``'20 x 20 box (centred on 0, 0)'``."""
+
+    @abstractmethod
+    def parameters(self) -> dict[str, Any]:
+        """The constructor's parameters, plain, as in a scenario file."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """`parameters` with the shape's name (``{"shape": kind, ...}``)."""
+        return {"shape": self.kind, **self.parameters()}
+
+    def wrap(self, position: FloatArray) -> FloatArray:
+        """Positions mapped into the primary cell of a periodic vessel; an unchanged copy
+        otherwise."""
+        return np.array(position, dtype=float, copy=True)
+
+    def minimum_image(self, displacement: FloatArray) -> FloatArray:
+        """The shortest periodic image of displacements ``(..., 2)``; unchanged otherwise."""
+        return displacement
