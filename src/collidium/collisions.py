@@ -22,8 +22,9 @@ from typing import Literal, Protocol
 import numpy as np
 
 from collidium.errors import SimulationError
-from collidium.kernels import events, stepper, walls
+from collidium.kernels import events, stepper
 from collidium.kernels.cells import event_grid_shape
+from collidium.kernels.vessels import box as box_walls
 from collidium.state import FloatArray, IntArray, Particles, as_given
 from collidium.vessels import Box
 
@@ -123,11 +124,11 @@ _NO_ACCELERATION = np.empty((0, 2))
 
 def _free_flight(particles: Particles, box: Box, dt: float, tally: Tally) -> None:
     if box.periodic:
-        walls.drift_periodic(
+        box_walls.drift_periodic(
             particles.position, particles.velocity, particles.image, box.width, box.height, dt
         )
     else:
-        walls.drift_reflecting(
+        box_walls.drift_reflecting(
             particles.position, particles.velocity, particles.radius, particles.mass,
             0.5 * box.width, 0.5 * box.height, dt, tally.counts[1:], tally.impulse[1:],
         )  # fmt: skip

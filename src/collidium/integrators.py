@@ -21,6 +21,7 @@ import numpy as np
 
 from collidium.collisions import Contact, Drift, Tally
 from collidium.forces import ForceField
+from collidium.kernels.vessels import box as box_walls
 from collidium.state import FloatArray, Particles
 from collidium.vessels import Box
 
@@ -311,10 +312,9 @@ def _shortened(
             return dx * dx + dy * dy - sigma * sigma, slope
     else:
         wall = -1 - j
-        axis, upper = wall // 2, wall % 2 == 1
-        half = 0.5 * (box.width, box.height)[axis]
+        axis = wall // 2
         radius = float(particles.radius[i])
-        target = (half - radius) if upper else (radius - half)
+        target = box_walls.contact_coordinate(wall, radius, 0.5 * box.width, 0.5 * box.height)
         x0, v0, a0 = float(x[i, axis]), float(v[i, axis]), float(a[i, axis])
 
         def gap(s: float) -> tuple[float, float]:

@@ -9,7 +9,7 @@ import pytest
 from collidium.kernels import reference
 from collidium.kernels.audit import first_invalid
 from collidium.kernels.placement import place_disks
-from collidium.kernels.walls import DRIFT_CHUNK, drift_periodic, drift_reflecting, fold
+from collidium.kernels.vessels.box import DRIFT_CHUNK, drift_periodic, drift_reflecting, fold
 
 
 def test_reflecting_drift_equals_twin(rng):
@@ -80,7 +80,8 @@ def test_audit_equals_twin(rng, periodic, n):
 
 
 def _fold_in_index_order(position, velocity, radius, mass, half, dt):
-    """The sequential drift: `walls.fold` particle by particle, wall tallies summed in order."""
+    """The sequential drift: `vessels.box.fold` particle by particle, wall tallies summed in
+    order."""
     hits, impulse = np.zeros(4, np.int64), np.zeros(4)
     for i in range(len(position)):
         for d in range(2):

@@ -8,6 +8,7 @@ import numba
 import numpy as np
 
 from collidium.kernels.stepper import chunk_count
+from collidium.kernels.vessels import box
 
 #: Particles from which the audit runs in parallel chunks; below, starting the threads would cost
 #: more than the pass (a two-disk scene took twice as long a step).
@@ -91,6 +92,6 @@ def _invalid(x, y, vx, vy, reach, limit_x, limit_y) -> int:
     0."""
     if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(vx) and math.isfinite(vy)):
         return 1
-    if abs(x) + reach > limit_x or abs(y) + reach > limit_y:
+    if box.reaches_outside(x, y, reach, limit_x, limit_y):
         return 2
     return 0

@@ -45,6 +45,7 @@ import numpy as np
 
 from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import elastic_response
+from collidium.kernels.vessels import box
 
 #: Columns of the ``body`` rows. RADIUS and MASS exist only in rows of `BODY_COLUMNS`; rows of
 #: `SHARED_BODY_COLUMNS` take them from ``geometry``.
@@ -281,19 +282,10 @@ def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid):
     periodic = grid[2] != 0
     best = math.inf
     code = NO_EVENT
-    if not periodic:  # walls: -1 - (2 d + upper)
-        for d in range(2):
-            v = vx if d == 0 else vy
-            pos = x if d == 0 else y
-            half = hw if d == 0 else hh
-            if v > 0.0:
-                delay = max((half - r - pos) / v, 0.0)
-                if delay < best:
-                    best, code = delay, -2 - 2 * d
-            elif v < 0.0:
-                delay = max((-half + r - pos) / v, 0.0)
-                if delay < best:
-                    best, code = delay, -1 - 2 * d
+    if not periodic:  # wall w has the code -1 - w
+        best, wall = box.wall_delay(x, y, vx, vy, r, hw, hh)
+        if wall >= 0:
+            code = -1 - wall
     for d in range(2):  # cell crossings: -5 - (2 d + upper)
         v = vx if d == 0 else vy
         pos = x if d == 0 else y
@@ -740,10 +732,9 @@ def _bounce(k, wall, t, body, ident, geometry, tally, impulse, acceleration, mid
     _advance(k, t, body)
     d = wall // 2
     upper = wall % 2 == 1
-    half = geometry[HALF_WIDTH + d]
     # Snap to the contact point so round-off never leaves the disk past the wall.
     r = _radius(k, body, geometry)
-    body[k, X + d] = (half - r) if upper else (r - half)
+    body[k, X + d] = box.contact_coordinate(wall, r, geometry[HALF_WIDTH], geometry[HALF_HEIGHT])
     before = body[k, VX + d]
     after = _wall_response(before, upper, ident[k], d, midpoint - t, acceleration)
     body[k, VX + d] = after

@@ -24,7 +24,8 @@ def elastic_response(
 
 
 def fold(x: float, v: float, lo: float, hi: float) -> tuple[float, float, int]:
-    """Reflect a coordinate back into ``[lo, hi]`` one bounce at a time (twin of `walls.fold`)."""
+    """Reflect a coordinate back into ``[lo, hi]`` one bounce at a time (twin of
+    `vessels.box.fold`)."""
     bounces = 0
     while x < lo or x > hi:
         x = 2 * lo - x if x < lo else 2 * hi - x
@@ -184,12 +185,23 @@ def _next_wall(
     position: FloatArray, velocity: FloatArray, radius: FloatArray, half: FloatArray
 ) -> tuple[float, int, int]:
     """Earliest wall contact: (delay, particle, axis)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         target = np.where(velocity > 0, half - radius[:, None], radius[:, None] - half)
         delay = np.where(velocity != 0, (target - position) / velocity, np.inf)
     delay = np.maximum(delay, 0.0)
     k, d = np.unravel_index(np.argmin(delay), delay.shape)
     return float(delay[k, d]), int(k), int(d)
+
+
+def box_wall_delay(
+    position: FloatArray, velocity: FloatArray, radius: float, half: FloatArray
+) -> tuple[float, int]:
+    """Twin of `vessels.box.wall_delay` for one disk: ``(delay, wall)`` (walls 0 left, 1 right,
+    2 bottom, 3 top), ``(inf, -1)`` at rest; ties to the x walls."""
+    delay, _, axis = _next_wall(position[None, :], velocity[None, :], np.array([radius]), half)
+    if not math.isfinite(delay):
+        return math.inf, -1
+    return delay, 2 * axis + int(velocity[axis] > 0)
 
 
 def _next_contact(
@@ -228,7 +240,7 @@ def drift_reflecting(
     half: FloatArray,
     dt: float,
 ) -> tuple[np.ndarray, FloatArray]:
-    """Twin of `walls.drift_reflecting`: straight drift, then bounce-by-bounce folding per
+    """Twin of `vessels.box.drift_reflecting`: straight drift, then bounce-by-bounce folding per
     coordinate. Updates position and velocity (N, 2) in place; returns hits per wall
     (left, right, bottom, top) and the momentum each wall received."""
     hits = np.zeros(4, dtype=np.int64)
@@ -250,7 +262,7 @@ def drift_reflecting(
 def drift_periodic(
     position: FloatArray, velocity: FloatArray, image: np.ndarray, size: FloatArray, dt: float
 ) -> None:
-    """Twin of `walls.drift_periodic`: drift, wrap into ``[-L/2, L/2)``, count the images."""
+    """Twin of `vessels.box.drift_periodic`: drift, wrap into ``[-L/2, L/2)``, count the images."""
     moved = position + velocity * dt
     shift = np.floor((moved + size / 2) / size)
     position[...] = moved - shift * size

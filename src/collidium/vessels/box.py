@@ -1,7 +1,7 @@
 """`Box`: a rectangle centred on the origin, reflecting or periodic.
 
 The geometry lives here; the fast time-of-impact and reflection arithmetic used inside a run is in
-`kernels/walls.py` (and the event engine), which take the half sizes this class provides.
+`kernels/vessels/box.py` (for every engine), which take the half sizes this class provides.
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""Wall reflection: exact mirror of the normal component, folding equal to bounce-by-bounce."""
+"""The box's wall kernels: exact mirror of the normal component, folding equal to
+bounce-by-bounce, time to a wall equal to its twin and ending at the contact point."""
 
 from __future__ import annotations
 
@@ -7,7 +8,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from collidium.kernels import reference
-from collidium.kernels.walls import drift_periodic, drift_reflecting, fold
+from collidium.kernels.vessels.box import (
+    contact_coordinate,
+    drift_periodic,
+    drift_reflecting,
+    fold,
+    reaches_outside,
+    wall_delay,
+)
 
 
 def test_wall_mirrors_the_normal_component():
@@ -43,3 +51,25 @@ def test_periodic_drift_wraps_and_counts_images():
     drift_periodic(position, velocity, image, 10.0, 10.0, 1.0)
     np.testing.assert_allclose(position, [[-3.5, 3.5]])
     np.testing.assert_array_equal(image, [[1, -1]])
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.floats(-4.5, 4.5), st.floats(-2.5, 2.5), st.floats(-20, 20), st.floats(-20, 20),
+    st.floats(0.0, 0.5),
+)  # fmt: skip
+def test_wall_delay_equals_its_twin_and_ends_at_the_contact_coordinate(x, y, vx, vy, r):
+    half = np.array([5.0, 3.0])
+    delay, wall = wall_delay(x, y, vx, vy, r, *half)
+    twin_delay, twin_wall = reference.box_wall_delay(np.array([x, y]), np.array([vx, vy]), r, half)
+    assert wall == twin_wall and (delay == twin_delay or abs(delay - twin_delay) <= 1e-12)
+    if wall >= 0:
+        axis = wall // 2
+        at = (x, y)[axis] + (vx, vy)[axis] * delay
+        assert abs(at - contact_coordinate(wall, r, *half)) <= 1e-9
+        assert not reaches_outside(x + vx * delay, y + vy * delay, r, *(half * (1 + 1e-9)))
+
+
+def test_a_disk_at_rest_meets_no_wall_and_one_past_a_wall_is_outside():
+    assert wall_delay(0.0, 0.0, 0.0, 0.0, 0.5, 5.0, 3.0) == (np.inf, -1)
+    assert reaches_outside(4.6, 0.0, 0.5, 5.0, 3.0) and not reaches_outside(4.5, 2.5, 0.5, 5.0, 3.0)

@@ -1,4 +1,11 @@
-"""Straight flight inside a rectangle with reflecting walls, folded exactly (any path length)."""
+"""The box's wall arithmetic, for every engine: the time to a wall and the contact point (exact
+engine), the exact fold of straight flight between walls (step and off modes), the wrap of a
+periodic box and the outside test (audit).
+
+The box is centred on the origin with half sides ``half_width, half_height`` (m); its walls are
+numbered 0 left, 1 right, 2 bottom, 3 top (wall ``w`` is on axis ``w // 2``, at the upper end when
+``w`` is odd), the order of `collidium.vessels.Box.wall_names`.
+"""
 
 from __future__ import annotations
 
@@ -6,6 +13,50 @@ import math
 
 import numba
 import numpy as np
+
+
+@numba.njit(cache=True, inline="always")
+def wall_delay(
+    x: float, y: float, vx: float, vy: float, r: float, half_width: float, half_height: float
+) -> tuple[float, int]:
+    """Time until a disk of radius ``r`` at (x, y) moving at (vx, vy) touches a wall.
+
+    Returns
+    -------
+    tuple
+        ``(delay in s, wall)``; ``(inf, -1)`` at rest. A disk already at or past a wall it moves
+        towards gets 0. Ties go to the x walls.
+    """
+    best = math.inf
+    wall = -1
+    for d in range(2):
+        v = vx if d == 0 else vy
+        position = x if d == 0 else y
+        half = half_width if d == 0 else half_height
+        if v > 0.0:
+            delay = max((half - r - position) / v, 0.0)
+            if delay < best:
+                best, wall = delay, 2 * d + 1
+        elif v < 0.0:
+            delay = max((-half + r - position) / v, 0.0)
+            if delay < best:
+                best, wall = delay, 2 * d
+    return best, wall
+
+
+@numba.njit(cache=True, inline="always")
+def contact_coordinate(wall: int, r: float, half_width: float, half_height: float) -> float:
+    """Where the centre of a disk of radius ``r`` touching ``wall`` is along the wall's axis
+    (``wall // 2``), in m: the snap that keeps round-off from leaving a disk past the wall."""
+    half = half_width if wall < 2 else half_height
+    return (half - r) if wall % 2 == 1 else (r - half)
+
+
+@numba.njit(cache=True, inline="always")
+def reaches_outside(x: float, y: float, reach: float, limit_x: float, limit_y: float) -> bool:
+    """Whether a disk at (x, y) reaching ``reach`` m from its centre (its radius; 0 for the
+    centre alone) passes the half sides ``limit_x, limit_y`` (m, round-off allowance included)."""
+    return abs(x) + reach > limit_x or abs(y) + reach > limit_y
 
 
 @numba.njit(cache=True, inline="always")
