@@ -130,7 +130,7 @@ def _packed_step_gas(n: int, seed: int, boundary: str = "reflecting") -> cd.Simu
     rng = np.random.default_rng(seed)
     radius = np.full(n, 0.25)
     radius[::50] = 0.15  # unequal radii are carried through the cell sort
-    position = random_positions(n, radius, side, side, rng)
+    position = random_positions(n, radius, cd.Box(side, side), rng)
     particles = cd.Particles(position, rng.normal(0, 2, (n, 2)), radius=radius)
     return cd.Simulation(cd.Box(side, side, boundary), particles, dt=0.02, collisions="step")
 

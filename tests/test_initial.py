@@ -14,6 +14,7 @@ from collidium.initial import (
     rhombus_rack,
     uniform_velocities,
 )
+from collidium.vessels import Box
 
 
 def min_gap(position: np.ndarray, radius: np.ndarray) -> float:
@@ -29,7 +30,7 @@ def min_gap(position: np.ndarray, radius: np.ndarray) -> float:
     ("n", "radius", "width", "height"), [(200, 0.25, 20, 20), (300, 0.4, 30, 12)]
 )
 def test_random_positions_inside_and_apart(n, radius, width, height):
-    position = random_positions(n, radius, width, height, np.random.default_rng(5))
+    position = random_positions(n, radius, Box(width, height), np.random.default_rng(5))
     assert position.shape == (n, 2)
     assert (np.abs(position[:, 0]) <= width / 2 - radius).all()
     assert (np.abs(position[:, 1]) <= height / 2 - radius).all()
@@ -37,15 +38,15 @@ def test_random_positions_inside_and_apart(n, radius, width, height):
 
 
 def test_random_positions_deterministic_given_the_generator():
-    a = random_positions(100, 0.25, 20, 20, np.random.default_rng(3))
-    b = random_positions(100, 0.25, 20, 20, np.random.default_rng(3))
-    c = random_positions(100, 0.25, 20, 20, np.random.default_rng(4))
+    a = random_positions(100, 0.25, Box(20, 20), np.random.default_rng(3))
+    b = random_positions(100, 0.25, Box(20, 20), np.random.default_rng(3))
+    c = random_positions(100, 0.25, Box(20, 20), np.random.default_rng(4))
     assert a.tobytes() == b.tobytes()
     assert not np.array_equal(a, c)
 
 
 def test_random_positions_fill_the_box_uniformly():
-    position = random_positions(4000, 0.05, 20, 20, np.random.default_rng(0))
+    position = random_positions(4000, 0.05, Box(20, 20), np.random.default_rng(0))
     # each quadrant holds 1000 +- 3 sigma (binomial sigma = sqrt(4000 / 4 * 3 / 4) ~ 27)
     counts = np.histogram2d(position[:, 0], position[:, 1], bins=2, range=[[-10, 10], [-10, 10]])
     assert np.all(np.abs(counts[0] - 1000) < 3 * 27.4)
@@ -54,7 +55,7 @@ def test_random_positions_fill_the_box_uniformly():
 def test_random_positions_avoid_existing_disks():
     big = np.array([[0.0, 0.0], [5.0, 5.0]])
     position = random_positions(
-        300, 0.25, 20, 20, np.random.default_rng(1), existing=big, existing_radius=[3.0, 2.0]
+        300, 0.25, Box(20, 20), np.random.default_rng(1), existing=big, existing_radius=[3.0, 2.0]
     )
     everything = np.concatenate([big, position])
     radii = np.concatenate([[3.0, 2.0], np.full(300, 0.25)])
@@ -63,7 +64,7 @@ def test_random_positions_avoid_existing_disks():
 
 def test_random_positions_too_dense_names_the_field():
     with pytest.raises(InputError) as info:
-        random_positions(3000, 0.25, 20, 20, np.random.default_rng(0), field="particles.2.n")
+        random_positions(3000, 0.25, Box(20, 20), np.random.default_rng(0), field="particles.2.n")
     assert info.value.field == "particles.2.n"
     assert "too dense" in info.value.reason
 
@@ -71,12 +72,12 @@ def test_random_positions_too_dense_names_the_field():
 def test_random_positions_gives_up_after_bounded_batches():
     # below the hexagonal limit but far above random close packing: cannot be placed at random
     with pytest.raises(InputError, match="too dense"):
-        random_positions(1400, 0.25, 20, 20, np.random.default_rng(0), max_batches=20)
+        random_positions(1400, 0.25, Box(20, 20), np.random.default_rng(0), max_batches=20)
 
 
 def test_random_positions_point_particles_and_empty():
-    assert random_positions(0, 0.25, 20, 20, np.random.default_rng(0)).shape == (0, 2)
-    points = random_positions(50, 0.0, 2, 2, np.random.default_rng(0))
+    assert random_positions(0, 0.25, Box(20, 20), np.random.default_rng(0)).shape == (0, 2)
+    points = random_positions(50, 0.0, Box(2, 2), np.random.default_rng(0))
     assert points.shape == (50, 2) and (np.abs(points) <= 1).all()
 
 

@@ -23,6 +23,7 @@ SECTIONS = {
     "charged-gas": "3.2.3",
     "pool-break": "4.1.1",
     "charged-no-collisions": "4.2.1",
+    "circle-gas": "5",
 }
 
 # name -> (positions, velocities, masses, charges, radius, Coulomb (k, softening) or None)
@@ -74,9 +75,12 @@ def test_default_vessel_and_run(name):
     assert scenario.run.dt == 0.01
     assert scenario.run.collisions == "exact"
     assert scenario.run.time == (60.0 if name == "pool-break" else 10.0)
-    assert scenario.box.boundary == "reflecting"
+    if name == "circle-gas":
+        assert scenario.vessel.model_dump() == {"shape": "circle", "radius": 11.3}
+        return
+    assert scenario.vessel.boundary == "reflecting"
     size = (40.0, 20.0) if name == "pool-break" else (20.0, 20.0)
-    assert (scenario.box.width, scenario.box.height) == size
+    assert (scenario.vessel.width, scenario.vessel.height) == size
 
 
 @pytest.mark.parametrize("name", list(TWO_BODY))
@@ -94,6 +98,17 @@ def test_few_body_presets_exact(name):
     else:
         (force,) = sim.forces
         assert (force.k, force.softening, force.max_acceleration) == (*coulomb, None)
+
+
+def test_circle_gas_is_the_gas_in_a_circle_and_keeps_its_angular_momentum():
+    sim = preset("circle-gas", n=150, vessel_radius=9.0).build()
+    p = sim.particles
+    assert p.n == 150 and sim.forces == ()
+    assert (np.hypot(*p.position.T) <= 9.0 - 0.25).all()
+    spin = sim.angular_momentum()
+    sim.run(time=10.0)
+    assert sim.counters.wall_hits["rim"] > 100 and sim.escaped() == 0
+    assert sim.angular_momentum() == pytest.approx(spin, rel=1e-10, abs=1e-10)
 
 
 @pytest.mark.parametrize("name", ["gas", "charged-gas"])
@@ -157,7 +172,7 @@ def test_common_overrides():
         height=12.0,
     )
     assert (scenario.run.dt, scenario.run.time, scenario.run.collisions) == (0.005, 3.0, "step")
-    assert (scenario.box.width, scenario.box.height, scenario.seed) == (30.0, 12.0, 7)
+    assert (scenario.vessel.width, scenario.vessel.height, scenario.seed) == (30.0, 12.0, 7)
     assert scenario.forces[0].k == 2.5
     p = scenario.build().particles
     assert (p.radius == 0.1).all() and (p.mass == 2.0).all()
@@ -200,7 +215,7 @@ def test_invalid_override_value_names_the_parameter():
 
 
 def test_load_preset_with_keywords_and_dotted_paths():
-    sim = load("gas", n=30, seed=2, **{"run.dt": 0.002, "box.boundary": "periodic"})
+    sim = load("gas", n=30, seed=2, **{"run.dt": 0.002, "vessel.boundary": "periodic"})
     assert sim.particles.n == 30 and sim.dt == 0.002 and sim.container.periodic
 
 

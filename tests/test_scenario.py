@@ -78,13 +78,17 @@ scenario_dicts = st.fixed_dictionaries(
         "name": st.text(max_size=20),
         "description": st.text(max_size=40),
         "seed": st.integers(0, 2**63 - 1),
-        "box": st.fixed_dictionaries(
-            {},
-            optional={
-                "width": positive,
-                "height": positive,
-                "boundary": st.sampled_from(["reflecting", "periodic"]),
-            },
+        "vessel": st.one_of(
+            st.fixed_dictionaries(
+                {},
+                optional={
+                    "shape": st.just("box"),
+                    "width": positive,
+                    "height": positive,
+                    "boundary": st.sampled_from(["reflecting", "periodic"]),
+                },
+            ),
+            st.fixed_dictionaries({"shape": st.just("circle")}, optional={"radius": positive}),
         ),
         "run": st.fixed_dictionaries(
             {},
@@ -141,7 +145,7 @@ def test_toml_file_round_trip(tmp_path):
 def test_written_toml_is_compact_and_readable():
     text = preset("head-on").to_toml()
     assert "position = [\n    [-1.0, 0.0],\n    [1.0, 0.0],\n]" in text
-    assert text.index("[box]") < text.index("[run]") < text.index("[[particles]]")
+    assert text.index("[vessel]") < text.index("[run]") < text.index("[[particles]]")
 
 
 def test_dump_toml_scalars_and_strings_are_escaped():
@@ -171,7 +175,7 @@ def with_field(path: str, value: Any) -> dict[str, Any]:
 
 
 @pytest.mark.parametrize(
-    "path", ["colour", "box.depth", "run.steps", "forces.0.power", "particles.0.velocity"]
+    "path", ["colour", "vessel.depth", "run.steps", "forces.0.power", "particles.0.velocity"]
 )
 def test_extra_fields_are_rejected_and_named(path):
     with pytest.raises(InputError) as info:
@@ -188,8 +192,9 @@ def test_extra_fields_are_rejected_and_named(path):
         ("run.dt", math.nan, "finite"),
         ("run.time", math.inf, "finite"),
         ("run.collisions", "fast", "'exact', 'step' or 'off'"),
-        ("box.width", 0, "must be > 0"),
-        ("box.boundary", "open", "'reflecting' or 'periodic'"),
+        ("vessel.width", 0, "must be > 0"),
+        ("vessel.boundary", "open", "'reflecting' or 'periodic'"),
+        ("vessel.shape", "torus", "unknown value 'torus'; choose from box, circle"),
         ("seed", -1, "must be >= 0"),
         ("seed", 1.5, "integer"),
         ("seed", 2**63, "must be <= 9223372036854775807"),
@@ -291,7 +296,7 @@ def test_outside_is_refused_and_named():
 
 
 def test_periodic_box_wraps_instead_of_refusing():
-    data = explicit([[0, 0], [10.5, 0]]) | {"box": {"boundary": "periodic"}}
+    data = explicit([[0, 0], [10.5, 0]]) | {"vessel": {"boundary": "periodic"}}
     sim = Scenario.from_dict(data).build()
     assert sim.particles.position[1, 0] == pytest.approx(-9.5)
 
@@ -346,10 +351,9 @@ def test_groups_concatenate_in_order_with_their_properties():
 def state_bytes(sim: Simulation) -> tuple[Any, ...]:
     p = sim.particles
     arrays = (p.position, p.velocity, p.mass, p.radius, p.charge)
-    box = sim.container
     return (
         *(a.tobytes() for a in arrays),
-        (box.width, box.height, box.boundary),
+        sim.container.to_dict(),
         tuple((f.k, f.softening, f.max_acceleration) for f in sim.forces),
         sim.dt,
         sim.collisions,
@@ -380,16 +384,23 @@ def test_export_then_load_every_preset_is_bitwise_identical(name, tmp_path):
 
 def test_apply_overrides_sets_dotted_paths_and_validates():
     data = preset("gas").to_dict()
-    out = apply_overrides(data, {"run.dt": 0.005, "particles.0.n": 300, "box.boundary": "periodic"})
+    out = apply_overrides(
+        data, {"run.dt": 0.005, "particles.0.n": 300, "vessel.boundary": "periodic"}
+    )
     assert out["run"]["dt"] == 0.005
     assert out["particles"][0]["n"] == 300
-    assert out["box"]["boundary"] == "periodic"
+    assert out["vessel"]["boundary"] == "periodic"
     assert data["run"]["dt"] == 0.01  # the input is not modified
 
 
 def test_apply_overrides_creates_missing_tables():
-    out = apply_overrides(GAS, {"box.width": 30.0})
-    assert out["box"] == {"width": 30.0, "height": 20.0, "boundary": "reflecting"}
+    out = apply_overrides(GAS, {"vessel.width": 30.0})
+    assert out["vessel"] == {
+        "shape": "box",
+        "width": 30.0,
+        "height": 20.0,
+        "boundary": "reflecting",
+    }
 
 
 @pytest.mark.parametrize(
@@ -427,7 +438,7 @@ def test_numpy_values_are_accepted():
 
 def test_random_disks_clear_the_periodic_images_of_listed_ones():
     data = {
-        "box": {"boundary": "periodic"},
+        "vessel": {"boundary": "periodic"},
         "particles": [
             {"kind": "explicit", "position": [[9.95, 0.0]]},
             {"kind": "random", "n": 600},

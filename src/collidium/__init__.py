@@ -12,10 +12,11 @@ from collidium.loading import load
 from collidium.presets import presets
 from collidium.simulation import Counters, Energy, Simulation, restore
 from collidium.state import Particles
-from collidium.vessels import Box
+from collidium.vessels import Box, Circle
 
 __all__ = [
     "Box",
+    "Circle",
     "Coulomb",
     "Counters",
     "Energy",

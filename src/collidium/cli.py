@@ -370,6 +370,7 @@ def _print_summary(summary: dict[str, Any]) -> None:
         ("max relative energy drift", "n/a" if drift is None else f"{drift:.3g}"),
         *([("warning", energy["warning"])] if energy.get("warning") else []),
         ("momentum", "({:.6g}, {:.6g}) kg m/s".format(*summary["momentum"])),
+        ("angular momentum", f"{summary['angular_momentum']:.10g} kg m^2/s"),
         ("pair collisions", f"{summary['collisions']['pair']}"),
         ("wall collisions", f"{summary['collisions']['wall']}"),
         ("collision rate", _number(summary["collisions"]["rate"], "/s")),

@@ -24,9 +24,8 @@ import numpy as np
 from collidium.errors import SimulationError
 from collidium.kernels import events, stepper
 from collidium.kernels.cells import event_grid_shape
-from collidium.kernels.vessels import box as box_walls
 from collidium.state import FloatArray, IntArray, Particles, as_given
-from collidium.vessels import Box
+from collidium.vessels import Vessel
 
 CollisionMode = Literal["exact", "step", "off"]
 COLLISION_MODES: tuple[CollisionMode, ...] = ("exact", "step", "off")
@@ -47,11 +46,12 @@ class Tally:
     Attributes
     ----------
     counts : ndarray of int64, shape (5,)
-        Pair collisions, then hits on the left, right, bottom and top wall.
+        Pair collisions, then hits on each wall in the order of the vessel's
+        `Vessel.wall_names` (the box's left, right, bottom, top; the circle's rim, then zeros).
     impulse : ndarray of float64, shape (5,)
         The collision virial ``sum r_ij . dp_i`` over pair collisions (kg m^2/s; ``r_ij`` the
         centre-to-centre vector at contact, ``dp_i`` the impulse on i), then the normal momentum
-        received by the left, right, bottom and top wall (kg m/s).
+        received by each wall, in the same order (kg m/s).
     """
 
     counts: IntArray = field(default_factory=_zeros_int)
@@ -84,7 +84,7 @@ class Drift(Protocol):
     def drift(
         self,
         particles: Particles,
-        box: Box,
+        vessel: Vessel,
         now: float,
         dt: float,
         tally: Tally,
@@ -122,35 +122,31 @@ def make_drift(mode: CollisionMode) -> Drift:
 _NO_ACCELERATION = np.empty((0, 2))
 
 
-def _free_flight(particles: Particles, box: Box, dt: float, tally: Tally) -> None:
-    if box.periodic:
-        box_walls.drift_periodic(
-            particles.position, particles.velocity, particles.image, box.width, box.height, dt
-        )
-    else:
-        box_walls.drift_reflecting(
-            particles.position, particles.velocity, particles.radius, particles.mass,
-            0.5 * box.width, 0.5 * box.height, dt, tally.counts[1:], tally.impulse[1:],
-        )  # fmt: skip
+def _free_flight(particles: Particles, vessel: Vessel, dt: float, tally: Tally) -> None:
+    p = particles
+    vessel.free_flight(
+        p.position, p.velocity, p.radius, p.mass, p.image, dt, tally.counts[1:], tally.impulse[1:]
+    )
 
 
-#: Box sides a particle may cross in one drift before the state counts as runaway (the event
-#: count of a drift grows with it; legitimate runs stay many orders of magnitude below).
+#: Vessel widths (its bounding box's shorter side) a particle may cross in one drift before the
+#: state counts as runaway (the event count of a drift grows with it; legitimate runs stay many
+#: orders of magnitude below).
 MAX_CROSSINGS_PER_DRIFT = 1e9
 
 
-def _refuse_runaway(particles: Particles, box: Box, dt: float) -> None:
+def _refuse_runaway(particles: Particles, vessel: Vessel, dt: float) -> None:
     """Stop before an event-driven drift whose event count would be astronomical."""
     if particles.n == 0:
         return
     velocity = particles.velocity
     # Reductions only: an (N, 2) temporary would add 16 bytes per disk to the peak memory.
     speed = max(float(velocity.max()), -float(velocity.min()))
-    if speed * dt > MAX_CROSSINGS_PER_DRIFT * min(box.width, box.height):
+    if speed * dt > MAX_CROSSINGS_PER_DRIFT * float(vessel.size.min()):
         fastest = int(np.abs(velocity).max(axis=1).argmax())
         raise SimulationError(
-            f"particle {fastest} moves at {speed:.3g} m/s, over {MAX_CROSSINGS_PER_DRIFT:.0g} box "
-            "sides per step: the state has run away; try a smaller dt or softening"
+            f"particle {fastest} moves at {speed:.3g} m/s, over {MAX_CROSSINGS_PER_DRIFT:.0g} "
+            "vessel widths per step: the state has run away; try a smaller dt or softening"
         )
 
 
@@ -171,7 +167,7 @@ class NoCollisions(_Stateless):
     def drift(
         self,
         particles: Particles,
-        box: Box,
+        vessel: Vessel,
         now: float,
         dt: float,
         tally: Tally,
@@ -179,7 +175,7 @@ class NoCollisions(_Stateless):
         halt_after: float = math.inf,
     ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place (never halts)."""
-        _free_flight(particles, box, dt, tally)
+        _free_flight(particles, vessel, dt, tally)
 
 
 class StepCollisions(_Stateless):
@@ -190,7 +186,7 @@ class StepCollisions(_Stateless):
 
     The pair search keeps the particles sorted into a cell grid of its own
     (`stepper.step_grid`), updated from step to step; the grid is kept while the number of
-    particles and the box stay the same and no disk grows past the diameter it was made for.
+    particles and the vessel stay the same and no disk grows past the diameter it was made for.
     Its arrays take about 80 bytes per particle (90 when the radii differ).
     """
 
@@ -205,14 +201,13 @@ class StepCollisions(_Stateless):
         self._pairs = np.empty(0, dtype=np.int64)
         self._scratch = np.empty(0, dtype=np.int64)
 
-    def _make_grid(self, particles: Particles, box: Box, diameter: float) -> None:
+    def _make_grid(self, particles: Particles, vessel: Vessel, diameter: float) -> None:
         n = particles.n
-        self._layout = (n, box.width, box.height, box.periodic)
+        width, height = (float(side) for side in vessel.size)
+        self._layout = (n, width, height, vessel.periodic)
         self._diameter = diameter
         self._sorted = False
-        ncx, ncy, self._general = stepper.step_grid(
-            box.width, box.height, diameter, n, box.periodic
-        )
+        ncx, ncy, self._general = stepper.step_grid(width, height, diameter, n, vessel.periodic)
         self._shape = (ncx, ncy)
         self._chunks = min(self.SEARCH_CHUNKS, ncy)
         index = np.int32 if max(n, ncx * ncy) < 2**31 - 1 else np.int64
@@ -230,11 +225,12 @@ class StepCollisions(_Stateless):
             self._pairs = np.empty(self._chunks * max(64, n // (8 * self._chunks)), dtype=np.int64)
             self._scratch = np.empty_like(self._pairs)
 
-    def _sort(self, particles: Particles, box: Box, fresh: bool, uniform: bool) -> None:
+    def _sort(self, particles: Particles, vessel: Vessel, fresh: bool, uniform: bool) -> None:
         """Sort the particles into cells (from last step's order when there is one)."""
+        width, height = (float(side) for side in vessel.size)
         if self._sorted:
             self._sorted = stepper.update_cells(
-                particles.position, particles.radius, fresh, uniform, box.width, box.height,
+                particles.position, particles.radius, fresh, uniform, width, height,
                 *self._shape, self._order, self._key, self._data_xy, self._data_r,
                 self._new_key, self._movers, self._grouped, self._moved, self._order_out,
                 self._key_out, self._start, self._cell_xy, self._cell_r,
@@ -244,7 +240,7 @@ class StepCollisions(_Stateless):
                 self._key, self._key_out = self._key_out, self._key
                 return
         stepper.sort_into_cells(
-            particles.position, particles.radius, uniform, box.width, box.height, *self._shape,
+            particles.position, particles.radius, uniform, width, height, *self._shape,
             self._movers, self._data_xy, self._data_r, self._cursor, self._order, self._key,
             self._start, self._cell_xy, self._cell_r,
         )  # fmt: skip
@@ -265,7 +261,7 @@ class StepCollisions(_Stateless):
     def drift(
         self,
         particles: Particles,
-        box: Box,
+        vessel: Vessel,
         now: float,
         dt: float,
         tally: Tally,
@@ -273,22 +269,23 @@ class StepCollisions(_Stateless):
         halt_after: float = math.inf,
     ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place (never halts)."""
-        _free_flight(particles, box, dt, tally)
+        _free_flight(particles, vessel, dt, tally)
         if particles.n == 0:
             return
         changed, uniform, largest = self._radius_summary(particles.radius)
-        layout = (particles.n, box.width, box.height, box.periodic)
+        width, height = (float(side) for side in vessel.size)
+        layout = (particles.n, width, height, vessel.periodic)
         # Cells must stay at least a diameter wide; they are kept if the disks shrink.
         if layout != self._layout or 2.0 * largest > self._diameter:
-            self._make_grid(particles, box, 2.0 * largest)
+            self._make_grid(particles, vessel, 2.0 * largest)
             changed = True
         if uniform and changed:  # equal radii: the same in every order, left alone by the sort
             self._cell_r.fill(largest)
-        self._sort(particles, box, changed, uniform)
+        self._sort(particles, vessel, changed, uniform)
         while True:
             count = stepper.overlapping_pairs(
                 self._start, self._order, self._cell_xy, self._cell_r, uniform, largest,
-                *self._shape, box.width, box.height, box.periodic, self._general, self._chunks,
+                *self._shape, width, height, vessel.periodic, self._general, self._chunks,
                 self._pairs, self._scratch,
             )  # fmt: skip
             if count >= 0:
@@ -297,7 +294,7 @@ class StepCollisions(_Stateless):
             self._scratch = np.empty_like(self._pairs)
         tally.counts[0] += stepper.resolve_pairs(
             self._pairs[:count], particles.position, particles.velocity, particles.mass,
-            box.width, box.height, box.periodic, tally.impulse,
+            width, height, vessel.periodic, tally.impulse,
         )  # fmt: skip
 
 
@@ -356,10 +353,11 @@ class ExactCollisions:
         )  # fmt: skip
         return bool(synced)
 
-    def _rebuild(self, particles: Particles, box: Box, now: float) -> dict[str, np.ndarray]:
+    def _rebuild(self, particles: Particles, vessel: Vessel, now: float) -> dict[str, np.ndarray]:
         n = particles.n
         diameter = 2.0 * float(particles.radius.max(initial=0.0))
-        ncx, ncy = event_grid_shape(box.width, box.height, diameter, n)
+        width, height = (float(side) for side in vessel.size)
+        ncx, ncy = event_grid_shape(width, height, diameter, n)
         shared = _shared_radius_and_mass(particles)
         columns = events.BODY_COLUMNS if shared is None else events.SHARED_BODY_COLUMNS
         # Arrays of the same shapes are filled again rather than allocated (with forces the queue
@@ -371,10 +369,10 @@ class ExactCollisions:
         else:
             s = _engine_arrays(n, ncx * ncy, columns)
         s["geometry"] = np.array(
-            [0.5 * box.width, 0.5 * box.height, box.width / ncx, box.height / ncy,
-             *(shared or (np.nan, np.nan))]
+            [0.5 * width, 0.5 * height, width / ncx, height / ncy, *(shared or (np.nan, np.nan)),
+             vessel.shape_code, vessel.rim]
         )  # fmt: skip
-        s["grid"] = np.array([ncx, ncy, int(box.periodic)], dtype=np.int64)
+        s["grid"] = np.array([ncx, ncy, int(vessel.periodic)], dtype=np.int64)
         events.load(
             particles.position, particles.velocity, particles.radius, particles.mass,
             s["body"], s["ident"],
@@ -385,7 +383,7 @@ class ExactCollisions:
     def drift(
         self,
         particles: Particles,
-        box: Box,
+        vessel: Vessel,
         now: float,
         dt: float,
         tally: Tally,
@@ -394,9 +392,9 @@ class ExactCollisions:
     ) -> Contact | None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place, or halt before the first
         contact of forced particles after ``halt_after`` (s) and return it (`Drift.drift`)."""
-        _refuse_runaway(particles, box, dt)
+        _refuse_runaway(particles, vessel, dt)
         if not self._is_current(particles):
-            self._state = self._rebuild(particles, box, now)
+            self._state = self._rebuild(particles, vessel, now)
             self.rebuilds += 1
         s = self._state
         assert s is not None

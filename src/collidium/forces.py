@@ -13,7 +13,7 @@ from collidium.errors import InputError
 from collidium.kernels import tree
 from collidium.kernels.pairwise import coulomb_direct, coulomb_stiffness
 from collidium.state import FloatArray, Particles
-from collidium.vessels import Box
+from collidium.vessels import Vessel
 
 SumMethod = Literal["auto", "direct", "tree"]
 SUM_METHODS: tuple[SumMethod, ...] = ("auto", "direct", "tree")
@@ -45,15 +45,15 @@ class Coulomb:
     method : {"auto", "direct", "tree"}
         How the pair sum is done: "direct", every pair in a parallel numba kernel, O(N^2), exact;
         "tree", a Barnes-Hut quadtree with order-4 multipoles, O(N log N) (`kernels/tree.py`);
-        "auto", the tree from `TREE_CROSSOVER` particles on in a walled box, else direct.
+        "auto", the tree from `TREE_CROSSOVER` particles on in a walled vessel, else direct.
     theta : float
         The tree's opening angle (0 < theta < 1): smaller is more accurate and slower. The
         default keeps the RMS relative force error below 1e-3 (see `kernels/tree.py`).
 
     Notes
     -----
-    In a periodic box the minimum image is used (an approximation until Ewald summation
-    exists); the tree cannot follow it, so a periodic box always sums directly.
+    In a periodic vessel the minimum image is used (an approximation until Ewald summation
+    exists); the tree cannot follow it, so a periodic vessel always sums directly.
     """
 
     k: float = 5.0
@@ -77,24 +77,24 @@ class Coulomb:
         if not (isinstance(self.theta, int | float) and 0.0 < self.theta < 1.0):
             raise InputError("forces.coulomb.theta", f"must be between 0 and 1, got {self.theta!r}")
 
-    def check_box(self, box: Box) -> None:
-        """Refuse the tree in a periodic box (it cannot follow the minimum image)."""
-        if box.periodic and self.method == "tree":
+    def check_box(self, vessel: Vessel) -> None:
+        """Refuse the tree in a periodic vessel (it cannot follow the minimum image)."""
+        if vessel.periodic and self.method == "tree":
             raise InputError(
                 "forces.coulomb.method",
-                "the tree cannot sum a periodic box (minimum image); use 'direct' or 'auto'",
+                "the tree cannot sum a periodic vessel (minimum image); use 'direct' or 'auto'",
             )
 
-    def uses_tree(self, particles: Particles, box: Box) -> bool:
-        """Whether `compute` sums by tree for these particles in this box."""
-        if box.periodic or self.method == "direct":
+    def uses_tree(self, particles: Particles, vessel: Vessel) -> bool:
+        """Whether `compute` sums by tree for these particles in this vessel."""
+        if vessel.periodic or self.method == "direct":
             return False
         return self.method == "tree" or particles.n >= TREE_CROSSOVER
 
     def compute(
         self,
         particles: Particles,
-        box: Box,
+        vessel: Vessel,
         force: FloatArray,
         energy: FloatArray,
         virial: FloatArray,
@@ -106,7 +106,7 @@ class Coulomb:
 
         ``work`` holds the tree's buffers between calls (filled on first use; a fresh one is made
         for this call if None)."""
-        if self.uses_tree(particles, box):
+        if self.uses_tree(particles, vessel):
             work = {} if work is None else work
             if not work:
                 work.update(tree.tree_buffers(particles.n))
@@ -115,12 +115,13 @@ class Coulomb:
                 virial, work, theta=self.theta,
             )  # fmt: skip
             return
+        width, height = (float(side) for side in vessel.size)  # the period, when periodic
         coulomb_direct(
             particles.position, particles.charge, self.k, self.softening**2,
-            box.width, box.height, box.periodic, force, energy, virial,
+            width, height, vessel.periodic, force, energy, virial,
         )  # fmt: skip
 
-    def stiffness(self, particles: Particles, box: Box, acceleration: FloatArray) -> float:
+    def stiffness(self, particles: Particles, vessel: Vessel, acceleration: FloatArray) -> float:
         """How fast this force's energies change: ``S`` in J^2/s^4, such that a leapfrog step h
         errs on the energy of the pair that is hardest to follow by about ``sqrt(S) h^2``
         (`collidium.integrators`).
@@ -132,13 +133,14 @@ class Coulomb:
         length, whichever is larger (the mean spacing for point particles without softening):
         ``|U_i| = m_i |a_i| l_i`` and ``rate_i^2 = (|v_i|^2 / l_i + |a_i|) / l_i``.
         """
-        if not self.uses_tree(particles, box):
+        if not self.uses_tree(particles, vessel):
+            width, height = (float(side) for side in vessel.size)
             return coulomb_stiffness(
                 particles.position, particles.velocity, particles.charge, particles.mass, self.k,
-                self.softening**2, box.width, box.height, box.periodic,
+                self.softening**2, width, height, vessel.periodic,
             )  # fmt: skip
         length = np.maximum(2.0 * particles.radius, self.softening)
-        spacing = math.sqrt(box.width * box.height / max(particles.n, 1))
+        spacing = math.sqrt(vessel.area / max(particles.n, 1))
         length = np.where(length > 0.0, length, spacing)
         pull = np.hypot(acceleration[:, 0], acceleration[:, 1])
         speed2 = np.einsum("ij,ij->i", particles.velocity, particles.velocity)
@@ -194,7 +196,7 @@ class ForceField:
         """True when at least one force acts."""
         return bool(self.forces)
 
-    def evaluate(self, particles: Particles, box: Box) -> FloatArray:
+    def evaluate(self, particles: Particles, vessel: Vessel) -> FloatArray:
         """Total acceleration (N, 2) in m/s^2 at the current positions; also caches the potential
         and the virial.
 
@@ -209,7 +211,7 @@ class ForceField:
         self._acceleration[...] = 0.0
         potential = virial = 0.0
         for force, work in zip(self.forces, self._work, strict=True):
-            force.compute(particles, box, self._force, self._energy, self._virial, work)
+            force.compute(particles, vessel, self._force, self._energy, self._virial, work)
             np.divide(self._force, particles.mass[:, None], out=self._force)  # now an acceleration
             force.limit(self._force)
             self._acceleration += self._force
@@ -220,30 +222,30 @@ class ForceField:
         self._evaluated_at = particles.position.copy()
         return self._acceleration
 
-    def stiffness(self, particles: Particles, box: Box) -> float:
+    def stiffness(self, particles: Particles, vessel: Vessel) -> float:
         """``S`` of all forces at the current state, in J^2/s^4: the largest of the forces'
         (`Coulomb.stiffness`; the acceleration of the last `evaluate` is used where one is
         needed)."""
         return max(
-            (force.stiffness(particles, box, self._acceleration) for force in self.forces),
+            (force.stiffness(particles, vessel, self._acceleration) for force in self.forces),
             default=0.0,
         )
 
-    def potential(self, particles: Particles, box: Box) -> float:
+    def potential(self, particles: Particles, vessel: Vessel) -> float:
         """Potential energy in J at the current positions (cached from the last evaluation)."""
-        self._refresh(particles, box)
+        self._refresh(particles, vessel)
         return self._potential
 
-    def virial(self, particles: Particles, box: Box) -> float:
+    def virial(self, particles: Particles, vessel: Vessel) -> float:
         """Pair virial ``sum_{i<j} r_ij . F_ij`` in J at the current positions (of the forces
-        before any acceleration cap; minimum image in a periodic box)."""
-        self._refresh(particles, box)
+        before any acceleration cap; minimum image in a periodic vessel)."""
+        self._refresh(particles, vessel)
         return self._virial_sum
 
-    def _refresh(self, particles: Particles, box: Box) -> None:
+    def _refresh(self, particles: Particles, vessel: Vessel) -> None:
         if not self.active:
             self._potential = self._virial_sum = 0.0
         elif self._evaluated_at is None or not np.array_equal(
             self._evaluated_at, particles.position
         ):
-            self.evaluate(particles, box)
+            self.evaluate(particles, vessel)

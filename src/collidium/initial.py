@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike
 from collidium.errors import InputError
 from collidium.kernels.placement import place_disks
 from collidium.state import FloatArray
+from collidium.vessels import Vessel
 
 #: Candidate batches tried by `random_positions` before it gives up.
 MAX_BATCHES = 200
@@ -25,39 +26,37 @@ HEXAGONAL_PACKING = math.pi / (2.0 * math.sqrt(3.0))
 def random_positions(
     n: int,
     radius: float | ArrayLike,
-    width: float,
-    height: float,
+    vessel: Vessel,
     rng: np.random.Generator,
     *,
     existing: ArrayLike | None = None,
     existing_radius: ArrayLike | None = None,
-    periodic: bool = False,
     field: str = "particles.n",
     max_batches: int = MAX_BATCHES,
 ) -> FloatArray:
-    """Uniform random centres of ``n`` non-overlapping disks inside a box centred on the origin.
+    """Uniform random centres of ``n`` non-overlapping disks inside a vessel.
 
-    Candidates are drawn in batches from ``rng`` and accepted in order when they overlap no disk
-    accepted before (random sequential adsorption, `collidium.kernels.placement.place_disks`).
+    Candidates are drawn in batches from ``rng`` in the vessel's bounding box, shrunk by the
+    largest radius, those not inside the vessel are dropped, and the rest are accepted in order
+    when they overlap no disk accepted before (random sequential adsorption,
+    `collidium.kernels.placement.place_disks`). In a box every candidate is inside, so the draw
+    is the box's own.
 
     Parameters
     ----------
     n : int
         Number of disks to place (>= 0).
     radius : float or array_like, shape (n,)
-        Radii in m (>= 0). Every centre is drawn in ``[-W/2 + r, W/2 - r] x [-H/2 + r, H/2 - r]``
-        with ``r`` the largest radius, so every disk lies fully inside the box (also in a periodic
-        box, where no disk then straddles the boundary).
-    width, height : float
-        Box sides W and H in m.
+        Radii in m (>= 0). Every disk, at the largest radius, lies fully inside the vessel (also
+        in a periodic box, where no disk then straddles the boundary).
+    vessel : Vessel
+        Where the disks go (`collidium.vessels`).
     rng : numpy.random.Generator
         Source of the candidates.
     existing : array_like, shape (M, 2), optional
-        Centres in m of disks already in the box that the new ones must not overlap.
+        Centres in m of disks already in the vessel that the new ones must not overlap.
     existing_radius : float or array_like, shape (M,), optional
         Radii in m of the existing disks (default 0).
-    periodic : bool
-        The box is periodic: new disks must also clear the images of existing disks near an edge.
     field : str
         Field named in the error when the disks do not fit.
     max_batches : int
@@ -71,7 +70,7 @@ def random_positions(
     Raises
     ------
     InputError
-        When the disks do not fit in the box, or ``n`` disks could not be placed after
+        When the disks do not fit in the vessel, or ``n`` disks could not be placed after
         ``max_batches`` batches (too dense for random placement).
     """
     radii = _radii(radius, n, "particles.radius")
@@ -81,15 +80,15 @@ def random_positions(
     r_max = float(radii.max(initial=0.0))
     if n == 0:
         return np.zeros((0, 2))
-    if periodic and m:
+    width, height = (float(side) for side in vessel.size)
+    if vessel.periodic and m:
         reach = r_max + float(old_radii.max())
         old, old_radii = _with_edge_images(old, old_radii, width, height, reach)
         m = old.shape[0]
-    if 2.0 * r_max > min(width, height):
-        raise InputError(
-            field, f"disks of radius {r_max:g} m do not fit in a {width:g} x {height:g} box"
-        )
-    _check_density(n, radii, old_radii, width, height, field)
+    if 2.0 * r_max > min(width, height) or vessel.available_area(r_max) <= 0.0:
+        fits = f"do not fit in the {vessel.describe()}"
+        raise InputError(field, f"disks of radius {r_max:g} m {fits}")
+    _check_density(n, radii, old_radii, vessel, field)
 
     all_radii = np.concatenate([old_radii, radii])
     position = np.zeros((m + n, 2))
@@ -103,24 +102,26 @@ def random_positions(
     )
     ncx = max(1, math.ceil(width / cell))
     ncy = max(1, math.ceil(height / cell))
-    lo = np.array([-0.5 * width, -0.5 * height])
+    lo = vessel.bounds[0]
     head, next_ = _cell_lists(old, lo, cell, ncx, ncy, m + n)
     low = lo + r_max
-    high = -lo - r_max
+    high = vessel.bounds[1] - r_max
     placed = m
     for _ in range(max_batches):
         batch = max(256, 2 * (m + n - placed))
         candidates = rng.uniform(low, high, size=(batch, 2))
+        inside = np.ones(batch, dtype=bool)
+        inside[vessel.outside(candidates, np.full(batch, r_max))] = False
         placed = place_disks(
-            candidates, all_radii, placed, position, lo, cell, ncx, ncy, head, next_
+            candidates[inside], all_radii, placed, position, lo, cell, ncx, ncy, head, next_
         )
         if placed == m + n:
             return position[m:].copy() if m else position
     raise InputError(
         field,
-        f"too dense: placed only {placed - m} of {n} disks of radius {r_max:g} m in a "
-        f"{width:g} x {height:g} box after {max_batches} tries; use fewer or smaller disks or a "
-        "larger box",
+        f"too dense: placed only {placed - m} of {n} disks of radius {r_max:g} m in the "
+        f"{vessel.describe()} after {max_batches} tries; use fewer or smaller disks or a "
+        "larger vessel",
     )
 
 
@@ -154,15 +155,16 @@ def _radii(value: float | ArrayLike, n: int, field: str) -> FloatArray:
 
 
 def _check_density(
-    n: int, radii: FloatArray, old_radii: FloatArray, width: float, height: float, field: str
+    n: int, radii: FloatArray, old_radii: FloatArray, vessel: Vessel, field: str
 ) -> None:
     """Refuse at once a covered area beyond the densest possible packing."""
     covered = math.pi * float(np.sum(radii**2) + np.sum(old_radii**2))
-    if covered > HEXAGONAL_PACKING * width * height:
+    room = HEXAGONAL_PACKING * vessel.area
+    if covered > room:
         raise InputError(
             field,
-            f"too dense: {n} disks cover {covered:g} m^2, more than the "
-            f"{HEXAGONAL_PACKING * width * height:g} m^2 that fit in a {width:g} x {height:g} box",
+            f"too dense: {n} disks cover {covered:g} m^2, more than the {room:g} m^2 that fit "
+            f"in the {vessel.describe()}",
         )
 
 

@@ -21,9 +21,8 @@ import numpy as np
 
 from collidium.collisions import Contact, Drift, Tally
 from collidium.forces import ForceField
-from collidium.kernels.vessels import box as box_walls
 from collidium.state import FloatArray, Particles
-from collidium.vessels import Box
+from collidium.vessels import Vessel
 
 IntegratorName = Literal["adaptive", "fixed"]
 INTEGRATORS: tuple[IntegratorName, ...] = ("adaptive", "fixed")
@@ -72,7 +71,7 @@ class Integrator:
     def step(
         self,
         particles: Particles,
-        box: Box,
+        vessel: Vessel,
         field: ForceField,
         drift: Drift,
         now: float,
@@ -85,14 +84,14 @@ class Integrator:
         evaluates it once before the first step, and the integrator keeps it current.
         """
         if field.active:
-            self._with_forces(particles, box, field, drift, now, dt, tally)
+            self._with_forces(particles, vessel, field, drift, now, dt, tally)
         else:
-            drift.drift(particles, box, now, dt, tally)
+            drift.drift(particles, vessel, now, dt, tally)
 
     def _with_forces(
         self,
         particles: Particles,
-        box: Box,
+        vessel: Vessel,
         field: ForceField,
         drift: Drift,
         now: float,
@@ -129,7 +128,7 @@ class Leapfrog(Integrator):
     def _with_forces(
         self,
         particles: Particles,
-        box: Box,
+        vessel: Vessel,
         field: ForceField,
         drift: Drift,
         now: float,
@@ -137,8 +136,8 @@ class Leapfrog(Integrator):
         tally: Tally,
     ) -> None:
         particles.velocity += (0.5 * dt) * field.acceleration
-        drift.drift(particles, box, now, dt, tally, field.acceleration)
-        particles.velocity += (0.5 * dt) * field.evaluate(particles, box)
+        drift.drift(particles, vessel, now, dt, tally, field.acceleration)
+        particles.velocity += (0.5 * dt) * field.evaluate(particles, vessel)
 
 
 class AdaptiveLeapfrog(Integrator):
@@ -197,7 +196,7 @@ class AdaptiveLeapfrog(Integrator):
     def _with_forces(
         self,
         particles: Particles,
-        box: Box,
+        vessel: Vessel,
         field: ForceField,
         drift: Drift,
         now: float,
@@ -205,21 +204,21 @@ class AdaptiveLeapfrog(Integrator):
         tally: Tally,
     ) -> None:
         start = _Snapshot(particles, tally)
-        n = max(self.substeps, self.needed(_squared_rate(particles, box, field), dt))
+        n = max(self.substeps, self.needed(_squared_rate(particles, vessel, field), dt))
         while True:
-            fastest = self._interval(particles, box, field, drift, now, dt, tally, n)
+            fastest = self._interval(particles, vessel, field, drift, now, dt, tally, n)
             required = self.needed(fastest, dt)
             if required <= n:
                 break
             start.restore(particles, tally)
-            field.evaluate(particles, box)
+            field.evaluate(particles, vessel)
             n = max(required, 2 * n)
         self.substeps = max(1, n // 2) if required <= n // 2 else n
 
     def _interval(
         self,
         particles: Particles,
-        box: Box,
+        vessel: Vessel,
         field: ForceField,
         drift: Drift,
         now: float,
@@ -230,19 +229,19 @@ class AdaptiveLeapfrog(Integrator):
         """Take the interval in ``n`` regular substeps (each split at contacts); returns the
         largest squared rate (1/s^2) met at their boundaries (the regular ones: they are the same
         forwards and backwards, and contacts come with their own substep boundaries)."""
-        fastest = _squared_rate(particles, box, field)
+        fastest = _squared_rate(particles, vessel, field)
         t = now
         for s in range(1, n + 1):
             end = now + dt * s / n
             while t < end:  # substeps shortened for contacts end at a contact, not at ``end``
-                t = self._substep(particles, box, field, drift, t, end, dt, tally)
-            fastest = max(fastest, _squared_rate(particles, box, field))
+                t = self._substep(particles, vessel, field, drift, t, end, dt, tally)
+            fastest = max(fastest, _squared_rate(particles, vessel, field))
         return fastest
 
     def _substep(
         self,
         particles: Particles,
-        box: Box,
+        vessel: Vessel,
         field: ForceField,
         drift: Drift,
         t: float,
@@ -257,18 +256,18 @@ class AdaptiveLeapfrog(Integrator):
         acceleration = field.acceleration
         particles.velocity += (0.5 * h) * acceleration
         contact = drift.drift(
-            particles, box, t, h, tally, acceleration, halt_after=t + CONTACT_WINDOW * dt
+            particles, vessel, t, h, tally, acceleration, halt_after=t + CONTACT_WINDOW * dt
         )
         if contact is not None:
             before.restore(particles, tally)
-            h = _shortened(particles, box, acceleration, contact, t, h, dt)
+            h = _shortened(particles, vessel, acceleration, contact, t, h, dt)
             particles.velocity += (0.5 * h) * acceleration
-            drift.drift(particles, box, t, h, tally, acceleration)
-        particles.velocity += (0.5 * h) * field.evaluate(particles, box)
+            drift.drift(particles, vessel, t, h, tally, acceleration)
+        particles.velocity += (0.5 * h) * field.evaluate(particles, vessel)
         return end if contact is None else t + h
 
 
-def _squared_rate(particles: Particles, box: Box, field: ForceField) -> float:
+def _squared_rate(particles: Particles, vessel: Vessel, field: ForceField) -> float:
     """The squared rate of the forces weighted by energy, 1/s^2: ``sqrt(S)`` (the energy error per
     squared second of the pair hardest to follow, `ForceField.stiffness`) over the total energy
     ``|KE + U|``, the scale the energy error is judged against, but never below a tenth of
@@ -276,14 +275,14 @@ def _squared_rate(particles: Particles, box: Box, field: ForceField) -> float:
     the energy by about ``h^2 rate^2`` of that scale."""
     p = particles
     kinetic = 0.5 * float(np.sum(p.mass * np.einsum("ij,ij->i", p.velocity, p.velocity)))
-    potential = field.potential(particles, box)
+    potential = field.potential(particles, vessel)
     scale = max(abs(kinetic + potential), (kinetic + abs(potential)) / TOTAL_ENERGY_FLOOR)
-    return math.sqrt(field.stiffness(particles, box)) / scale if scale > 0.0 else 0.0
+    return math.sqrt(field.stiffness(particles, vessel)) / scale if scale > 0.0 else 0.0
 
 
 def _shortened(
     particles: Particles,
-    box: Box,
+    vessel: Vessel,
     acceleration: FloatArray,
     contact: Contact,
     t: float,
@@ -294,36 +293,40 @@ def _shortened(
 
     The drift after a kick ``a h / 2`` follows ``x + v h + a h^2 / 2`` at its end, so the contact
     time is a root of ``|r + w h + b h^2 / 2| = sigma`` for a pair (relative position, velocity
-    and acceleration) or of ``x + v h + a h^2 / 2 = wall`` for a wall, found by Newton's method
+    and acceleration) or the vessel's `Vessel.wall_gap` for a wall, found by Newton's method
     from the straight-path time the drift found. If that fails, the straight-path time is used.
     """
     straight = contact.time - t
     i, j = contact.particle, contact.partner
     x, v, a = particles.position, particles.velocity, acceleration
-    if j >= 0:  # plain floats: a handful of Newton steps on scalars
-        rx, ry = (float(c) for c in box.minimum_image(x[i] - x[j]))
-        wx, wy = float(v[i, 0] - v[j, 0]), float(v[i, 1] - v[j, 1])
-        bx, by = float(a[i, 0] - a[j, 0]), float(a[i, 1] - a[j, 1])
-        sigma = float(particles.radius[i] + particles.radius[j])
-
-        def gap(s: float) -> tuple[float, float]:
-            dx, dy = rx + (wx + 0.5 * bx * s) * s, ry + (wy + 0.5 * by * s) * s
-            slope = 2.0 * (dx * (wx + bx * s) + dy * (wy + by * s))
-            return dx * dx + dy * dy - sigma * sigma, slope
+    if j >= 0:
+        gap = _pair_gap(particles, vessel, acceleration, i, j)
     else:
-        wall = -1 - j
-        axis = wall // 2
-        radius = float(particles.radius[i])
-        target = box_walls.contact_coordinate(wall, radius, 0.5 * box.width, 0.5 * box.height)
-        x0, v0, a0 = float(x[i, axis]), float(v[i, axis]), float(a[i, axis])
-
-        def gap(s: float) -> tuple[float, float]:
-            return x0 + (v0 + 0.5 * a0 * s) * s - target, v0 + a0 * s
-
+        gap = vessel.wall_gap(-1 - j, x[i], v[i], a[i], float(particles.radius[i]))
     root = _newton(gap, straight)
     if not (math.isfinite(root) and 0.0 < root <= h):
         root = straight
     return max(root - CONTACT_MARGIN * dt, 0.5 * root)
+
+
+def _pair_gap(
+    particles: Particles, vessel: Vessel, acceleration: FloatArray, i: int, j: int
+) -> Callable[[float], tuple[float, float]]:
+    """``s -> (|r(s)|^2 - sigma^2, its derivative)`` for the pair (i, j) on their kick-drift-kick
+    parabolas, ``r(s) = r + w s + b s^2 / 2`` (relative position, velocity, acceleration)."""
+    x, v, a = particles.position, particles.velocity, acceleration
+    # Plain floats: a handful of Newton steps on scalars.
+    rx, ry = (float(c) for c in vessel.minimum_image(x[i] - x[j]))
+    wx, wy = float(v[i, 0] - v[j, 0]), float(v[i, 1] - v[j, 1])
+    bx, by = float(a[i, 0] - a[j, 0]), float(a[i, 1] - a[j, 1])
+    sigma = float(particles.radius[i] + particles.radius[j])
+
+    def gap(s: float) -> tuple[float, float]:
+        dx, dy = rx + (wx + 0.5 * bx * s) * s, ry + (wy + 0.5 * by * s) * s
+        slope = 2.0 * (dx * (wx + bx * s) + dy * (wy + by * s))
+        return dx * dx + dy * dy - sigma * sigma, slope
+
+    return gap
 
 
 def _newton(

@@ -1,6 +1,7 @@
 """The seed report's configurations as scenarios: one small builder per preset, registered by name.
 
-Default vessel: a 20 m x 20 m reflecting box centred on the origin; m = 1 kg, r = 0.25 m,
+Default vessel: a 20 m x 20 m reflecting box centred on the origin (a circle of radius
+``vessel_radius`` for the presets that take it); m = 1 kg, r = 0.25 m,
 k = 5 N m^2/C^2, dt = 0.01 s, seed 1, run time 10 s (pool-break: 60 s), unless a preset says
 otherwise. Every preset takes keyword overrides and gives a `Scenario`::
 
@@ -45,6 +46,8 @@ _COMMON: dict[str, Any] = {
     "width": 20.0,
     "height": 20.0,
     "boundary": "reflecting",
+    # A circular vessel's radius, m: about the area of the 20 m x 20 m box.
+    "vessel_radius": 11.3,
 }
 _NEUTRAL = (
     "seed", "dt", "time", "collisions", "integrator", "tolerance", "mass", "radius", "width",
@@ -118,11 +121,7 @@ def _scenario(name: str, values: dict[str, Any]) -> Scenario:
             "name": name,
             "description": title,
             "seed": values["seed"],
-            "box": {
-                "width": values["width"],
-                "height": values["height"],
-                "boundary": values["boundary"],
-            },
+            "vessel": _vessel(entry, values),
             "run": {
                 key: values[key] for key in ("dt", "time", "collisions", "integrator", "tolerance")
             },
@@ -130,6 +129,13 @@ def _scenario(name: str, values: dict[str, Any]) -> Scenario:
             "particles": particles,
         }
     )
+
+
+def _vessel(entry: _Entry, values: dict[str, Any]) -> dict[str, Any]:
+    """A preset's vessel table: a circle for the presets taking ``vessel_radius``, else a box."""
+    if "vessel_radius" in entry.parameters:
+        return {"shape": "circle", "radius": values["vessel_radius"]}
+    return {key: values[key] for key in ("width", "height", "boundary")}
 
 
 def _pair(
@@ -264,6 +270,20 @@ def charged_no_collisions(mass: float, radius: float) -> Particles:
     """The charged-opposite pair as point particles (radius 0) with Coulomb softening 0.05 m
     (the seed's epsilon); try dt 0.01, 0.005, 0.001 s."""
     return charged_opposite(mass, radius)
+
+
+@_preset(
+    "circle-gas",
+    "5",
+    "neutral disks (200) at random in a circular vessel; energy and angular momentum constant",
+    common=(*(key for key in _NEUTRAL if key not in ("width", "height")), "vessel_radius"),
+    title="{n} neutral disks at random in a circle of radius {vessel_radius:g} m",
+)
+def circle_gas(mass: float, radius: float, *, n: int = 200, speed: float = 10.0) -> Particles:
+    """The gas preset in a circle of radius ``vessel_radius`` (11.3 m): the rim conserves the
+    angular momentum about the centre as well as the energy (the seed's future work: other
+    shapes of vessel)."""
+    return gas(mass, radius, n=n, speed=speed)
 
 
 def presets() -> list[str]:

@@ -6,10 +6,12 @@ A scenario file::
     description = "200 neutral disks"
     seed = 1                      # seeds every random generator in the file
 
-    [box]
-    width = 20.0                  # m
-    height = 20.0                 # m
-    boundary = "reflecting"       # or "periodic"
+    [vessel]
+    shape = "box"                 # "box" | "circle"
+    width = 20.0                  # m (box)
+    height = 20.0                 # m (box)
+    boundary = "reflecting"       # or "periodic" (box)
+    # radius = 10.0               # m (circle)
 
     [run]
     dt = 0.01                     # s, the reporting interval
@@ -53,8 +55,10 @@ import tomli_w
 from pydantic import (
     BaseModel,
     ConfigDict,
+    Discriminator,
     Field,
     PlainValidator,
+    Tag,
     ValidationError,
     ValidationInfo,
     field_validator,
@@ -79,7 +83,7 @@ from collidium.observers import (
 )
 from collidium.simulation import Simulation, outside_detail, overlap_detail
 from collidium.state import FloatArray, Particles, uniform_or_each
-from collidium.vessels import Box
+from collidium.vessels import VESSELS, Box, Circle, Vessel
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -129,10 +133,11 @@ class _Model(BaseModel):
 
 
 class BoxSpec(_Model):
-    """The vessel: a rectangle centred on the origin, sides in m."""
+    """A rectangular vessel centred on the origin, sides in m (`collidium.vessels.Box`)."""
 
     model_config = ConfigDict(extra="forbid", strict=True)
 
+    shape: Literal["box"] = "box"
     width: Positive = 20.0
     height: Positive = 20.0
     boundary: Literal["reflecting", "periodic"] = "reflecting"
@@ -140,6 +145,32 @@ class BoxSpec(_Model):
     def build(self) -> Box:
         """The `Box` this describes."""
         return Box(self.width, self.height, boundary=self.boundary)
+
+
+class CircleSpec(_Model):
+    """A circular vessel centred on the origin, radius in m (`collidium.vessels.Circle`)."""
+
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    shape: Literal["circle"]
+    radius: Positive = 10.0
+
+    def build(self) -> Circle:
+        """The `Circle` this describes."""
+        return Circle(self.radius)
+
+
+def _shape_of(value: Any) -> str:
+    """The ``shape`` that selects a vessel's model; a table without one is a box."""
+    if isinstance(value, Mapping):
+        return str(value.get("shape", "box"))
+    return str(getattr(value, "shape", "box"))
+
+
+VesselSpec = Annotated[
+    Annotated[BoxSpec, Tag("box")] | Annotated[CircleSpec, Tag("circle")],
+    Discriminator(_shape_of),
+]
 
 
 class RunSpec(_Model):
@@ -350,7 +381,7 @@ class ExplicitGroup(_Model):
         return len(self.position)
 
     def generate(
-        self, rng: np.random.Generator, box: Box, existing: GroupState, index: int
+        self, rng: np.random.Generator, vessel: Vessel, existing: GroupState, index: int
     ) -> GroupState:
         """The listed particles (no random draws)."""
         n = len(self.position)
@@ -385,14 +416,13 @@ class RandomGroup(_Model):
         return self.n
 
     def generate(
-        self, rng: np.random.Generator, box: Box, existing: GroupState, index: int
+        self, rng: np.random.Generator, vessel: Vessel, existing: GroupState, index: int
     ) -> GroupState:
         """Draw positions (clear of the ``existing`` disks), then velocities, then (balanced)
         charges from ``rng``; ``index`` is the group's place in the list, named in errors."""
         position = random_positions(
-            self.n, self.radius, box.width, box.height, rng,
-            existing=box.wrap(existing.position), existing_radius=existing.radius,
-            periodic=box.periodic, field=f"particles.{index}.n",
+            self.n, self.radius, vessel, rng, existing=vessel.wrap(existing.position),
+            existing_radius=existing.radius, field=f"particles.{index}.n",
         )  # fmt: skip
         velocity = uniform_velocities(self.n, self.speed, rng)
         if self.charges == "balanced":
@@ -424,7 +454,7 @@ class RackGroup(_Model):
         return self.rows**2 - 1 + int(self.back_tip)
 
     def generate(
-        self, rng: np.random.Generator, box: Box, existing: GroupState, index: int
+        self, rng: np.random.Generator, vessel: Vessel, existing: GroupState, index: int
     ) -> GroupState:
         """The rack's centres (no random draws); all at rest."""
         position = rhombus_rack((self.apex[0], self.apex[1]), self.rows, self.radius, self.gap,
@@ -437,6 +467,9 @@ class RackGroup(_Model):
 
 
 Group = Annotated[ExplicitGroup | RandomGroup | RackGroup, Field(discriminator="kind")]
+
+#: Model of the vessel table, by its shape (for error messages).
+_VESSEL_SPECS: dict[str, type[_Model]] = {"box": BoxSpec, "circle": CircleSpec}
 
 #: Model of each table, by the discriminator value that selects it (for error messages).
 _TAGGED: dict[str, type[_Model]] = {
@@ -462,8 +495,8 @@ class Scenario(_Model):
         Label and one-line description.
     seed : int
         Seed of every random draw (group order) and of the simulation's generator.
-    box : BoxSpec
-        The vessel.
+    vessel : BoxSpec or CircleSpec
+        The vessel, chosen by its ``shape``.
     run : RunSpec
         dt, default duration and collision mode.
     forces : list of CoulombSpec
@@ -479,7 +512,7 @@ class Scenario(_Model):
     name: str = "scenario"
     description: str = ""
     seed: Annotated[int, Field(ge=0, le=2**63 - 1)] = 0
-    box: BoxSpec = Field(default_factory=BoxSpec)
+    vessel: VesselSpec = Field(default_factory=BoxSpec)
     run: RunSpec = Field(default_factory=RunSpec)
     forces: list[ForceSpec] = Field(default_factory=list)
     particles: Annotated[list[Group], Field(min_length=1)]
@@ -496,6 +529,12 @@ class Scenario(_Model):
         """
         if not isinstance(data, Mapping):
             raise InputError("scenario", f"expected a table of fields, got {type(data).__name__}")
+        if "box" in data:
+            raise InputError(
+                "box",
+                'the vessel is now [vessel], with shape = "box" and the same width, height and '
+                "boundary",
+            )
         try:
             return cls.model_validate(plain(data))
         except ValidationError as exc:
@@ -546,13 +585,12 @@ class Scenario(_Model):
         """A scenario that builds ``sim``'s current state: its vessel, run settings and forces,
         and its particles as one explicit group (positions wrapped into a periodic box)."""
         p = sim.particles
-        box = sim.container
         return cls.from_dict(
             {
                 "name": name or sim.name,
                 "description": f"the state of {sim.name} at t = {sim.time:.6g} s",
                 "seed": sim.seed or 0,
-                "box": {"width": box.width, "height": box.height, "boundary": box.boundary},
+                "vessel": sim.container.to_dict(),
                 "run": {
                     "dt": sim.dt,
                     "collisions": sim.collisions,
@@ -573,21 +611,21 @@ class Scenario(_Model):
             }
         )
 
-    def initial_state(self) -> tuple[Box, Particles, list[int]]:
+    def initial_state(self) -> tuple[Vessel, Particles, list[int]]:
         """Generate the vessel and the particles.
 
         Returns
         -------
-        box : Box
+        vessel : Vessel
         particles : Particles
             All groups concatenated in order.
         offsets : list of int
             Index of the first particle of each group, then the total N (length groups + 1).
         """
-        box = self.box.build()
+        vessel = self.vessel.build()
         rng = np.random.default_rng(self.seed)
         fixed = {
-            index: group.generate(rng, box, _empty(), index)
+            index: group.generate(rng, vessel, _empty(), index)
             for index, group in enumerate(self.particles)
             if not isinstance(group, RandomGroup)
         }
@@ -597,14 +635,15 @@ class Scenario(_Model):
                 groups.append(fixed[index])
                 continue
             drawn = [state for k, state in enumerate(groups) if k not in fixed]
-            groups.append(group.generate(rng, box, _concatenate([*fixed.values(), *drawn]), index))
+            drawn_before = _concatenate([*fixed.values(), *drawn])
+            groups.append(group.generate(rng, vessel, drawn_before, index))
         state = _concatenate(groups)
         offsets = [0, *np.cumsum([len(g.mass) for g in groups]).tolist()]
         particles = Particles(
             position=state.position, velocity=state.velocity, mass=uniform_or_each(state.mass),
             radius=uniform_or_each(state.radius), charge=uniform_or_each(state.charge),
         )  # fmt: skip
-        return box, particles, offsets
+        return vessel, particles, offsets
 
     def build(self) -> Simulation:
         """The `Simulation` this scenario describes (bitwise the same on every call).
@@ -615,16 +654,16 @@ class Scenario(_Model):
             For a particle outside the vessel or overlapping another (both named by their group
             and index), a random group too dense to place, or anything `Simulation` refuses.
         """
-        box, particles, offsets = self.initial_state()
+        vessel, particles, offsets = self.initial_state()
         try:
             sim = Simulation(
-                box, particles, forces=[force.build() for force in self.forces], dt=self.run.dt,
+                vessel, particles, forces=[force.build() for force in self.forces], dt=self.run.dt,
                 collisions=self.run.collisions, seed=self.seed, name=self.name,
                 integrator=self.run.integrator, tolerance=self.run.tolerance,
             )  # fmt: skip
         except InputError as exc:
             if exc.particles:
-                raise self._placement_error(exc.particles, box, particles, offsets) from None
+                raise self._placement_error(exc.particles, vessel, particles, offsets) from None
             raise InputError(_SIMULATION_FIELDS.get(exc.field, exc.field), exc.reason) from exc
         self._check_traced(particles.n)
         sim.observers.extend(spec.build() for spec in self.observers)
@@ -640,16 +679,16 @@ class Scenario(_Model):
                     )
 
     def _placement_error(
-        self, culprits: tuple[int, ...], box: Box, particles: Particles, offsets: list[int]
+        self, culprits: tuple[int, ...], vessel: Vessel, particles: Particles, offsets: list[int]
     ) -> InputError:
         """A `Simulation` placement error restated with the particles named by group."""
         last = culprits[-1]
         field, label = _particle_name(last, offsets, self)
         if len(culprits) == 1:
-            detail = outside_detail(box, particles, last)
+            detail = outside_detail(vessel, particles, last)
         else:
             first = _particle_name(culprits[0], offsets, self)[1]
-            detail = f"overlaps {first} {overlap_detail(box, particles, culprits[0], last)}"
+            detail = f"overlaps {first} {overlap_detail(vessel, particles, culprits[0], last)}"
         return InputError(field, f"{_local(field, label)}{detail}", particles=culprits)
 
 
@@ -795,7 +834,7 @@ def apply_overrides(data: Mapping[str, Any], overrides: Mapping[str, Any]) -> di
         Scenario data, e.g. from `Scenario.to_dict` or a TOML file (not modified).
     overrides : mapping of str to value
         Dotted path -> new value. List entries are addressed by index; a missing table on the way
-        (``box`` in ``box.width``) is created.
+        (``vessel`` in ``vessel.width``) is created.
 
     Returns
     -------
@@ -866,13 +905,19 @@ def describe(exc: ValidationError) -> str:
     return f"{field}: {reason}"
 
 
+def _is_tag(loc: tuple[int | str, ...], k: int) -> bool:
+    """Whether ``loc[k]`` is a discriminator value pydantic inserted: a list entry's kind or the
+    vessel's shape."""
+    if k == 0:
+        return False
+    before = loc[k - 1]
+    return (isinstance(before, int) and loc[k] in _TAGGED) or (
+        before == "vessel" and k == 1 and loc[k] in _VESSEL_SPECS
+    )
+
+
 def _clean_loc(loc: tuple[int | str, ...]) -> list[int | str]:
-    out: list[int | str] = []
-    for k, part in enumerate(loc):
-        if k > 0 and isinstance(loc[k - 1], int) and part in _TAGGED:
-            continue
-        out.append(part)
-    return out
+    return [part for k, part in enumerate(loc) if not _is_tag(loc, k)]
 
 
 #: pydantic's bound errors: (the comparison, the context key holding the bound).
@@ -896,6 +941,8 @@ def _reason(error: Any) -> tuple[str, str]:
         return path, f"unknown field{hint}"
     if kind == "missing":
         return path, "required field is missing"
+    if kind == "union_tag_invalid" and loc == ["vessel"]:
+        return "vessel.shape", f"unknown value {ctx.get('tag')!r}; choose from {', '.join(VESSELS)}"
     if kind in ("union_tag_not_found", "union_tag_invalid"):
         tag = str(ctx.get("discriminator", "kind")).strip("'")
         observer = bool(loc) and loc[0] == "observers"
@@ -937,8 +984,8 @@ def _allowed_fields(loc: tuple[int | str, ...]) -> list[str]:
     for k, part in enumerate(loc):
         if isinstance(part, int):
             model = None  # a list entry: its kind (the next part) decides the model
-        elif k > 0 and isinstance(loc[k - 1], int) and part in _TAGGED:
-            model = _TAGGED[part]
+        elif _is_tag(loc, k):
+            model = _TAGGED[str(part)] if isinstance(loc[k - 1], int) else _VESSEL_SPECS[str(part)]
         elif k == 0 or isinstance(loc[k - 1], str):
             fields = model.model_fields if model is not None else {}
             if part not in fields:

@@ -38,7 +38,7 @@ from collidium.kernels.audit import first_invalid
 from collidium.kernels.cells import first_overlap, grid_shape
 from collidium.observers.base import Observer
 from collidium.state import PROPERTIES, FloatArray, Particles, as_given
-from collidium.vessels import OUTSIDE_TOLERANCE, Box, Vessel, vessel_from_dict
+from collidium.vessels import OUTSIDE_TOLERANCE, Vessel, vessel_from_dict
 
 #: Most steps one `Simulation.run` call accepts (a guard against a mistyped time or dt).
 MAX_STEPS = 1e12
@@ -75,8 +75,8 @@ class Simulation:
 
     Parameters
     ----------
-    container : Box
-        The vessel.
+    container : Vessel
+        The vessel (`collidium.vessels`: a `Box` or a `Circle`).
     particles : Particles
         Initial state (the simulation keeps and updates this object).
     forces : sequence of Coulomb, optional
@@ -102,7 +102,7 @@ class Simulation:
     Raises
     ------
     InputError
-        For a bad dt, mode, integrator or tolerance, disks too large for the box, overlapping
+        For a bad dt, mode, integrator or tolerance, disks too large for the vessel, overlapping
         disks (the pair is named) or a particle outside the vessel.
     """
 
@@ -110,7 +110,7 @@ class Simulation:
 
     def __init__(
         self,
-        container: Box,
+        container: Vessel,
         particles: Particles,
         forces: Sequence[Coulomb] = (),
         dt: float = 0.01,
@@ -133,7 +133,7 @@ class Simulation:
 
     def _setup(
         self,
-        container: Box,
+        container: Vessel,
         particles: Particles,
         forces: Sequence[Coulomb],
         dt: float,
@@ -280,10 +280,10 @@ class Simulation:
 
     def _audit(self) -> None:
         p = self.particles
-        box = self.container
+        vessel = self.container
         index, reason = first_invalid(
-            p.position, p.velocity, p.radius, 0.5 * box.width, 0.5 * box.height, box.periodic,
-            OUTSIDE_TOLERANCE,
+            p.position, p.velocity, p.radius, vessel.shape_code,
+            *vessel.audit_limits(OUTSIDE_TOLERANCE), vessel.periodic,
         )  # fmt: skip
         if index < 0:
             return
@@ -291,7 +291,7 @@ class Simulation:
         if reason == 1:
             bad = np.flatnonzero(~np.isfinite(p.position).all(1) | ~np.isfinite(p.velocity).all(1))
         else:
-            bad = box.outside(p.position, p.radius)
+            bad = vessel.outside(p.position, p.radius)
         listed = ", ".join(str(int(i)) for i in bad[:10]) + (" ..." if bad.size > 10 else "")
         raise SimulationError(
             f"step {self.steps} (t = {self.time:.6g} s): particle(s) {listed} {what}"
@@ -326,6 +326,13 @@ class Simulation:
         """Total momentum ``sum m v``, shape (2,), in kg m/s."""
         return np.asarray(self.particles.mass @ self.particles.velocity)
 
+    def angular_momentum(self) -> float:
+        """Total angular momentum about the origin, ``sum m (x v_y - y v_x)``, kg m^2/s: conserved
+        in a circle (about its centre), not by the flat walls of a box."""
+        p = self.particles
+        x, v = p.position, p.velocity
+        return float(np.sum(p.mass * (x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0])))
+
     def total_speed(self) -> float:
         """Sum of the particles' speeds in m/s (the seed's "total speed", Fig. 2)."""
         return float(np.sum(np.hypot(self.particles.velocity[:, 0], self.particles.velocity[:, 1])))
@@ -356,6 +363,7 @@ class Simulation:
             "steps": self.steps,
             "energy": {"kinetic": e.kinetic, "potential": e.potential, "total": e.total},
             "momentum": [float(x) for x in self.momentum()],
+            "angular_momentum": self.angular_momentum(),
             "total_speed": self.total_speed(),
             "collisions": {"pair": c.pair_collisions, "wall": c.wall_collisions},
             "escaped": self.escaped(),
@@ -492,10 +500,12 @@ def _check_setup(
     forces: Sequence[Coulomb],
     dt: float,
     collisions: str,
-) -> Box:
-    """Refuse a bad setup (one line naming the field); the vessel, which the engines take."""
-    if not isinstance(container, Box):  # the engines know the box alone so far
-        raise InputError("container", f"must be a Box, got {type(container).__name__}")
+) -> Vessel:
+    """Refuse a bad setup (one line naming the field); returns the vessel."""
+    if not isinstance(container, Vessel):
+        raise InputError(
+            "container", f"must be a vessel (Box, Circle), got {type(container).__name__}"
+        )
     if not isinstance(particles, Particles):
         raise InputError("particles", f"must be Particles, got {type(particles).__name__}")
     _check_forces(forces, container)
@@ -505,7 +515,7 @@ def _check_setup(
     return container
 
 
-def _check_forces(forces: Sequence[Coulomb], container: Box) -> None:
+def _check_forces(forces: Sequence[Coulomb], container: Vessel) -> None:
     for k, force in enumerate(forces):
         if not isinstance(force, Coulomb):
             raise InputError(f"forces.{k}", f"unknown force {type(force).__name__}")
@@ -534,21 +544,21 @@ def _check_dt(dt: float) -> None:
         raise InputError("dt", f"must be a finite number > 0, got {dt!r}")
 
 
-def outside_detail(container: Box, particles: Particles, i: int) -> str:
+def outside_detail(container: Vessel, particles: Particles, i: int) -> str:
     """Where particle i is and why that is outside the vessel (for error messages)."""
     x, y = particles.position[i]
     radius = particles.radius[i]
     return f"at ({x:g}, {y:g}) with radius {radius:g} is outside the {container.describe()}"
 
 
-def overlap_detail(container: Box, particles: Particles, i: int, j: int) -> str:
+def overlap_detail(container: Vessel, particles: Particles, i: int, j: int) -> str:
     """How far apart two overlapping disks are (for error messages)."""
     gap = np.linalg.norm(container.minimum_image(particles.position[j] - particles.position[i]))
     radius = particles.radius
     return f"(centres {gap:g} m apart, radii {radius[i]:g} + {radius[j]:g})"
 
 
-def _check_placement(container: Box, particles: Particles, collisions: str) -> None:
+def _check_placement(container: Vessel, particles: Particles, collisions: str) -> None:
     outside = container.outside(particles.position, particles.radius)
     if outside.size:
         i = int(outside[0])
@@ -556,14 +566,12 @@ def _check_placement(container: Box, particles: Particles, collisions: str) -> N
         raise InputError("position", f"particle {i} {detail}", particles=(i,))
     if collisions == "off":
         return  # pass-through disks may overlap
-    ncx, ncy = grid_shape(
-        container.width, container.height, 2.0 * float(particles.radius.max(initial=0.0)),
-        particles.n,
-    )  # fmt: skip
+    width, height = (float(side) for side in container.size)
+    diameter = 2.0 * float(particles.radius.max(initial=0.0))
+    ncx, ncy = grid_shape(width, height, diameter, particles.n)
     i, j = first_overlap(
-        particles.position, particles.radius, container.width, container.height,
-        container.periodic, ncx, ncy,
-    )  # fmt: skip
+        particles.position, particles.radius, width, height, container.periodic, ncx, ncy
+    )
     if i >= 0:
         detail = overlap_detail(container, particles, i, j)
         raise InputError("position", f"particles {i} and {j} overlap {detail}", particles=(i, j))

@@ -63,7 +63,7 @@ def test_resumed_run_of_disks_of_two_masses_is_bitwise_the_uninterrupted_one(tmp
 
 
 def test_restore_keeps_dt_changes_the_random_generator_and_periodic_images(tmp_path):
-    whole = cd.load("gas", **{"box.boundary": "periodic"})
+    whole = cd.load("gas", **{"vessel.boundary": "periodic"})
     whole.run(steps=50)
     whole.dt = 0.003  # the time origin moves: time stays exact across the change
     whole.run(steps=50)
@@ -142,7 +142,7 @@ def test_other_npz_files_and_incomplete_checkpoints_are_refused(tmp_path):
 
 def test_the_vessel_is_saved_and_checkpoints_that_name_a_box_still_restore(tmp_path):
     path = tmp_path / "run.ckpt"
-    sim = cd.load("gas", n=50, **{"box.boundary": "periodic"}).run(steps=5)
+    sim = cd.load("gas", n=50, **{"vessel.boundary": "periodic"}).run(steps=5)
     sim.save(path)
     arrays, meta = read_checkpoint(path)
     assert meta["simulation"]["vessel"] == {"shape": "box", **sim.container.parameters()}

@@ -79,7 +79,7 @@ def test_freud_reads_the_file(tmp_path):
 
 
 def test_periodic_images_and_flag(tmp_path):
-    sim, path = record(tmp_path, "gas", every=100, steps=400, **{"box.boundary": "periodic"})
+    sim, path = record(tmp_path, "gas", every=100, steps=400, **{"vessel.boundary": "periodic"})
     trajectory = read_trajectory(path)
     assert trajectory.periodic
     with gsd.hoomd.open(path) as frames:

@@ -9,6 +9,7 @@ import pytest
 from collidium.kernels import reference
 from collidium.kernels.audit import first_invalid
 from collidium.kernels.placement import place_disks
+from collidium.kernels.vessels import BOX, CIRCLE
 from collidium.kernels.vessels.box import DRIFT_CHUNK, drift_periodic, drift_reflecting, fold
 
 
@@ -59,24 +60,27 @@ def test_placement_equals_twin(rng):
 
 
 @pytest.mark.parametrize("n", [200, 20_000])
-@pytest.mark.parametrize("periodic", [False, True])
-def test_audit_equals_twin(rng, periodic, n):
+@pytest.mark.parametrize(("shape", "periodic"), [(BOX, False), (BOX, True), (CIRCLE, False)])
+def test_audit_equals_twin(rng, shape, periodic, n):
     """In one pass, or in parallel chunks (4 at N = 20,000): the first bad particle is found,
-    wherever the bad ones lie."""
-    position = rng.uniform(-4.9, 4.9, (n, 2))
+    wherever the bad ones lie, in a box of half side 5 m or a circle of radius 5 m."""
+    position = rng.uniform(-3.5, 3.5, (n, 2))
     velocity = rng.normal(0, 1, (n, 2))
     radius = np.full(n, 0.05)
-    half = np.array([5.0, 5.0])
-    assert first_invalid(position, velocity, radius, 5.0, 5.0, periodic, 1e-9) == (-1, 0)
+    limit = 5.0 * (1 + 1e-9)
+    assert first_invalid(position, velocity, radius, shape, limit, limit, periodic) == (-1, 0)
     two_chunks = [(3 * n // 5, "position", [0.0, -5.2]), (n // 4 + 1, "velocity", [0.0, np.inf])]
+    corner = [(7, "position", [3.6, 3.6])]  # inside the box, outside the circle
     cases = [[(57, "position", [4.97, 0.0])], [(n - 1, "velocity", [np.nan, 0.0])], two_chunks]
-    for bad in cases:
+    for bad in [*cases, corner]:
         p, v = position.copy(), velocity.copy()
         for index, field, value in bad:
             (p if field == "position" else v)[index] = value
-        want = reference.first_invalid(p, v, radius, half, periodic, 1e-9)
-        assert first_invalid(p, v, radius, 5.0, 5.0, periodic, 1e-9) == want
-        assert want[0] == min(index for index, *_ in bad) or (periodic and bad[0][0] == 57)
+        want = reference.first_invalid(p, v, radius, shape, limit, limit, periodic)
+        assert first_invalid(p, v, radius, shape, limit, limit, periodic) == want
+        found = min(index for index, *_ in bad)
+        inside = (periodic and bad[0][0] == 57) or (shape == BOX and bad is corner)
+        assert want[0] == (-1 if inside and len(bad) == 1 else found)
 
 
 def _fold_in_index_order(position, velocity, radius, mass, half, dt):

@@ -15,7 +15,7 @@ from collidium.observers import Every, Tracer
 def test_free_flight_is_ballistic_across_periodic_boundaries():
     """Without collisions the unwrapped displacement is v t exactly, so MSD = <v^2> t^2 even after
     particles have crossed the box many times."""
-    sim = cd.load("gas", collisions="off", **{"box.boundary": "periodic"})
+    sim = cd.load("gas", collisions="off", **{"vessel.boundary": "periodic"})
     tracer = Tracer(trigger=Every(100))
     sim.observers.append(tracer)
     sim.run(time=10.0)

@@ -165,7 +165,7 @@ def test_the_page_is_saved_as_a_screenshot(page, artifacts):
 
 TWO_DISKS = """
 name = "two"
-[box]
+[vessel]
 width = 20.0
 height = 20.0
 [run]

@@ -46,9 +46,9 @@ LOG_KEYS = {
     "momentum": "total momentum (px, py), kg m/s",
     "temperature": "kT = KE / N, J",
     "collisions/pair": "pair collisions since the start",
-    "collisions/walls": "hits on the left, right, bottom, top wall since the start",
+    "collisions/walls": "hits on each wall since the start, in the vessel's wall order",
     "impulse/virial": "collision virial sum r_ij . dp_i since the start, kg m^2/s",
-    "impulse/walls": "momentum received by the left, right, bottom, top wall, kg m/s",
+    "impulse/walls": "momentum received by each wall, in the vessel's wall order, kg m/s",
     "virial/forces": "pair virial of the forces now, J",
 }
 

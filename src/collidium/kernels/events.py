@@ -45,7 +45,7 @@ import numpy as np
 
 from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import elastic_response
-from collidium.kernels.vessels import box
+from collidium.kernels.vessels import CIRCLE, box, circle
 
 #: Columns of the ``body`` rows. RADIUS and MASS exist only in rows of `BODY_COLUMNS`; rows of
 #: `SHARED_BODY_COLUMNS` take them from ``geometry``.
@@ -53,10 +53,11 @@ X, Y, VX, VY, STAMP, RADIUS, MASS = range(7)
 BODY_COLUMNS = 7  # 56 bytes
 SHARED_BODY_COLUMNS = 5  # 40 bytes: every disk has the radius and mass in ``geometry``
 
-#: Entries of ``geometry`` (m, and kg for SHARED_MASS): the box's half sides, the cell sides, and
-#: the radius and mass of every disk when the rows have no columns for them (else NaN).
-HALF_WIDTH, HALF_HEIGHT, CELL_WIDTH, CELL_HEIGHT, SHARED_RADIUS, SHARED_MASS = range(6)
-GEOMETRY_SIZE = 6
+#: Entries of ``geometry`` (m, and kg for SHARED_MASS): the half sides of the vessel's bounding
+#: box, the cell sides, the radius and mass of every disk when the rows have no columns for them
+#: (else NaN), the vessel's shape code (`collidium.kernels.vessels`) and, for a circle, its radius.
+HALF_WIDTH, HALF_HEIGHT, CELL_WIDTH, CELL_HEIGHT, SHARED_RADIUS, SHARED_MASS, SHAPE, RIM = range(8)
+GEOMETRY_SIZE = 8
 
 #: Columns of the ``event`` rows (int32): the next event's code, the earliest pair contact found
 #: (its partner's slot, or -1; the event itself if it comes first) and that partner's collision
@@ -283,7 +284,10 @@ def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid):
     best = math.inf
     code = NO_EVENT
     if not periodic:  # wall w has the code -1 - w
-        best, wall = box.wall_delay(x, y, vx, vy, r, hw, hh)
+        if geometry[SHAPE] == CIRCLE:
+            best, wall = circle.wall_delay(x, y, vx, vy, r, geometry[RIM])
+        else:
+            best, wall = box.wall_delay(x, y, vx, vy, r, hw, hh)
         if wall >= 0:
             code = -1 - wall
     for d in range(2):  # cell crossings: -5 - (2 d + upper)
@@ -728,17 +732,35 @@ def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
 
 @_engine(inline="always")
 def _bounce(k, wall, t, body, ident, geometry, tally, impulse, acceleration, midpoint):
-    """Slot k hits wall ``wall`` (0 left, 1 right, 2 bottom, 3 top) at time t (s)."""
+    """Slot k hits wall ``wall`` at time t (s): the box's 0 left, 1 right, 2 bottom, 3 top, or
+    the circle's rim 0. The disk is first snapped to the contact point, so that round-off never
+    leaves it past the wall."""
     _advance(k, t, body)
-    d = wall // 2
-    upper = wall % 2 == 1
-    # Snap to the contact point so round-off never leaves the disk past the wall.
     r = _radius(k, body, geometry)
-    body[k, X + d] = box.contact_coordinate(wall, r, geometry[HALF_WIDTH], geometry[HALF_HEIGHT])
-    before = body[k, VX + d]
-    after = _wall_response(before, upper, ident[k], d, midpoint - t, acceleration)
-    body[k, VX + d] = after
-    impulse[WALL_HITS + wall] += _mass(k, body, geometry) * abs(after - before)
+    if geometry[SHAPE] == CIRCLE:
+        x, y = circle.contact_point(body[k, X], body[k, Y], r, geometry[RIM])
+        body[k, X] = x
+        body[k, Y] = y
+        nx, ny = circle.outward_normal(x, y)
+        outward = body[k, VX] * nx + body[k, VY] * ny
+        pull = 0.0
+        if acceleration.shape[0] > 0:
+            pull = acceleration[ident[k], 0] * nx + acceleration[ident[k], 1] * ny
+        change = _wall_response(outward, pull, midpoint - t, acceleration.shape[0] > 0) - outward
+        body[k, VX] += change * nx
+        body[k, VY] += change * ny
+    else:  # the box: the normal is an axis, so the response is exact in floating point
+        d = wall // 2
+        hw, hh = geometry[HALF_WIDTH], geometry[HALF_HEIGHT]
+        body[k, X + d] = box.contact_coordinate(wall, r, hw, hh)
+        sign = 1.0 if wall % 2 == 1 else -1.0
+        before = body[k, VX + d]
+        pull = acceleration[ident[k], d] if acceleration.shape[0] > 0 else 0.0
+        after = sign * _wall_response(sign * before, sign * pull, midpoint - t,
+                                      acceleration.shape[0] > 0)  # fmt: skip
+        change = after - before
+        body[k, VX + d] = after
+    impulse[WALL_HITS + wall] += _mass(k, body, geometry) * abs(change)
     tally[WALL_HITS + wall] += 1
 
 
@@ -772,14 +794,16 @@ def _pair_response(k, j, nx, ny, lead, body, ident, geometry, acceleration):
 
 
 @_engine(inline="always")
-def _wall_response(v, upper, i, d, lead, acceleration):
-    """Normal velocity after a wall bounce, with the same kick-timing correction as pairs:
-    ``v' = -(v - delta) + delta``, kept only if it moves away from the wall (i: the particle)."""
-    if acceleration.shape[0] > 0:
-        corrected = -v + 2.0 * lead * acceleration[i, d]
-        if (corrected < 0.0) if upper else (corrected > 0.0):
+def _wall_response(outward, pull, lead, forced):
+    """Velocity along a wall's outward normal after a bounce, from ``outward`` before it (m/s),
+    with the kick-timing correction of pairs when ``forced``: ``pull`` is the acceleration along
+    the normal (m/s^2), ``lead`` as in `_pair_response`; ``v' = -(v - delta) + delta`` is kept
+    only if it leaves the wall, else ``-v``."""
+    if forced:
+        corrected = -outward + 2.0 * lead * pull
+        if corrected < 0.0:
             return corrected
-    return -v
+    return -outward
 
 
 # --- between the engine and the particles -------------------------------------------------------

@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from collidium.kernels.vessels import CIRCLE
 from collidium.state import FloatArray, IntArray
 
 
@@ -204,6 +205,41 @@ def box_wall_delay(
     return delay, 2 * axis + int(velocity[axis] > 0)
 
 
+def circle_wall_delay(
+    position: FloatArray, velocity: FloatArray, radius: float, rim: float
+) -> tuple[float, int]:
+    """Twin of `vessels.circle.wall_delay`: the largest root of ``|x + v t|^2 = (rim - r)^2``
+    from NumPy's polynomial roots, ``(delay, 0)``, or ``(inf, -1)`` at rest."""
+    a = float(velocity @ velocity)
+    if a == 0.0:
+        return math.inf, -1
+    reach = rim - radius
+    roots = np.roots([a, 2.0 * float(position @ velocity), float(position @ position) - reach**2])
+    return max(float(np.max(roots.real)), 0.0), 0
+
+
+def circle_drift_reflecting(
+    position: FloatArray, velocity: FloatArray, radius: FloatArray, rim: float, dt: float
+) -> int:
+    """Twin of `vessels.circle.drift_reflecting`: each disk flies to the rim (`circle_wall_delay`),
+    has the normal component of its velocity reversed there, and flies on; in place. Returns the
+    bounces."""
+    bounces = 0
+    for i in range(len(position)):
+        left = dt
+        while True:
+            delay, _ = circle_wall_delay(position[i], velocity[i], radius[i], rim)
+            if delay >= left:
+                position[i] += velocity[i] * left
+                break
+            position[i] += velocity[i] * delay
+            normal = position[i] / np.linalg.norm(position[i])
+            velocity[i] -= 2.0 * (velocity[i] @ normal) * normal
+            left -= delay
+            bounces += 1
+    return bounces
+
+
 def _next_contact(
     position: FloatArray, velocity: FloatArray, radius: FloatArray, size: FloatArray, periodic: bool
 ) -> tuple[float, int, int]:
@@ -288,15 +324,20 @@ def first_invalid(
     position: FloatArray,
     velocity: FloatArray,
     radius: FloatArray,
-    half: FloatArray,
+    shape: int,
+    limit_x: float,
+    limit_y: float,
     periodic: bool,
-    tolerance: float,
 ) -> tuple[int, int]:
     """Twin of `audit.first_invalid`: (index, 1) for a non-finite value, (index, 2) for a particle
-    outside the box, whichever index comes first; (-1, 0) if none."""
+    outside the vessel (a box of half sides ``limit_x, limit_y``, or a circle of radius
+    ``limit_x``), whichever index comes first; (-1, 0) if none."""
     finite = np.asarray(np.isfinite(position).all(axis=1) & np.isfinite(velocity).all(axis=1))
-    reach = np.abs(position) + (0.0 if periodic else radius[:, None])
-    inside = (reach <= half * (1 + tolerance)).all(axis=1)
+    reach = 0.0 if periodic else radius
+    if shape == CIRCLE:
+        inside = np.hypot(position[:, 0], position[:, 1]) + reach <= limit_x
+    else:
+        inside = (np.abs(position) + np.asarray(reach)[..., None] <= [limit_x, limit_y]).all(axis=1)
     bad = np.flatnonzero(~finite | ~inside)
     if bad.size == 0:
         return -1, 0

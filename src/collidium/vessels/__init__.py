@@ -13,9 +13,10 @@ from typing import Any
 from collidium.errors import InputError
 from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
 from collidium.vessels.box import Box
+from collidium.vessels.circle import Circle
 
 #: Vessel classes by their `Vessel.kind` (the ``shape`` of a scenario file or checkpoint).
-VESSELS: dict[str, type[Vessel]] = {cls.kind: cls for cls in (Box,)}
+VESSELS: dict[str, type[Vessel]] = {cls.kind: cls for cls in (Box, Circle)}
 
 
 def vessel_from_dict(data: dict[str, Any]) -> Vessel:
@@ -27,4 +28,4 @@ def vessel_from_dict(data: dict[str, Any]) -> Vessel:
     return VESSELS[shape](**parameters)
 
 
-__all__ = ["OUTSIDE_TOLERANCE", "VESSELS", "Box", "Vessel", "vessel_from_dict"]
+__all__ = ["OUTSIDE_TOLERANCE", "VESSELS", "Box", "Circle", "Vessel", "vessel_from_dict"]

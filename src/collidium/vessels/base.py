@@ -3,7 +3,9 @@ the views ask for, so that none of them knows a shape."""
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
@@ -23,6 +25,8 @@ class Vessel(ABC):
 
     #: The shape's name in scenario files and checkpoints (``shape: box``).
     kind: ClassVar[str]
+    #: The code the kernels know the shape by (`collidium.kernels.vessels`).
+    shape_code: ClassVar[int]
 
     @property
     def periodic(self) -> bool:
@@ -94,6 +98,46 @@ class Vessel(ABC):
     @abstractmethod
     def parameters(self) -> dict[str, Any]:
         """The constructor's parameters, plain, as in a scenario file."""
+
+    @property
+    def rim(self) -> float:
+        """A circle's radius in m, for the kernels (NaN for shapes without one)."""
+        return math.nan
+
+    @abstractmethod
+    def audit_limits(self, tolerance: float) -> tuple[float, float]:
+        """The two limits (m) of the audit's outside test (`collidium.kernels.audit`) with a
+        relative round-off allowance ``tolerance``."""
+
+    @abstractmethod
+    def free_flight(
+        self,
+        position: FloatArray,
+        velocity: FloatArray,
+        radius: FloatArray,
+        mass: FloatArray,
+        image: IntArray,
+        dt: float,
+        wall_hits: IntArray,
+        wall_impulse: FloatArray,
+    ) -> None:
+        """Move every disk for ``dt`` s in straight lines, in place, with exact specular
+        reflections off the walls (or the periodic wrap), adding each wall's hits and the
+        momentum it receives (kg m/s) to ``wall_hits`` and ``wall_impulse`` (`wall_names`
+        order); ``image`` counts periodic wraps."""
+
+    @abstractmethod
+    def wall_gap(
+        self,
+        wall: int,
+        position: FloatArray,
+        velocity: FloatArray,
+        acceleration: FloatArray,
+        radius: float,
+    ) -> Callable[[float], tuple[float, float]]:
+        """How far a disk of ``radius`` m on the path ``x + v s + a s^2 / 2`` (shapes (2,), m,
+        m/s, m/s^2) is from touching ``wall`` at time s: ``s -> (gap, d gap / ds)``, zero at
+        contact and negative inside (in a unit of the shape's choosing), for Newton's method."""
 
     def to_dict(self) -> dict[str, Any]:
         """`parameters` with the shape's name (``{"shape": kind, ...}``)."""

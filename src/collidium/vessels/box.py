@@ -6,11 +6,14 @@ The geometry lives here; the fast time-of-impact and reflection arithmetic used 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, ClassVar, Literal
 
 import numpy as np
 
 from collidium.errors import InputError
+from collidium.kernels.vessels import BOX
+from collidium.kernels.vessels import box as box_walls
 from collidium.state import FloatArray, IntArray
 from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
 
@@ -36,6 +39,7 @@ class Box(Vessel):
     """
 
     kind: ClassVar[str] = "box"
+    shape_code: ClassVar[int] = BOX
 
     def __init__(self, width: float, height: float, boundary: Boundary = "reflecting") -> None:
         for name, value in (("width", width), ("height", height)):
@@ -136,6 +140,51 @@ class Box(Vessel):
             return displacement
         size = self.size
         return displacement - size * np.round(displacement / size)
+
+    def audit_limits(self, tolerance: float) -> tuple[float, float]:
+        """The half sides with the round-off allowance, m."""
+        return 0.5 * self.width * (1.0 + tolerance), 0.5 * self.height * (1.0 + tolerance)
+
+    def free_flight(
+        self,
+        position: FloatArray,
+        velocity: FloatArray,
+        radius: FloatArray,
+        mass: FloatArray,
+        image: IntArray,
+        dt: float,
+        wall_hits: IntArray,
+        wall_impulse: FloatArray,
+    ) -> None:
+        """`Vessel.free_flight`: the exact fold between the walls, or the periodic wrap
+        (`collidium.kernels.vessels.box`)."""
+        if self.periodic:
+            box_walls.drift_periodic(position, velocity, image, self.width, self.height, dt)
+        else:
+            box_walls.drift_reflecting(
+                position, velocity, radius, mass, 0.5 * self.width, 0.5 * self.height, dt,
+                wall_hits, wall_impulse,
+            )  # fmt: skip
+
+    def wall_gap(
+        self,
+        wall: int,
+        position: FloatArray,
+        velocity: FloatArray,
+        acceleration: FloatArray,
+        radius: float,
+    ) -> Callable[[float], tuple[float, float]]:
+        """`Vessel.wall_gap`: the distance (m) along the wall's axis to the contact coordinate,
+        signed towards the wall."""
+        axis = wall // 2
+        half_width, half_height = 0.5 * self.width, 0.5 * self.height
+        target = box_walls.contact_coordinate(wall, radius, half_width, half_height)
+        x, v, a = float(position[axis]), float(velocity[axis]), float(acceleration[axis])
+
+        def gap(s: float) -> tuple[float, float]:
+            return x + (v + 0.5 * a * s) * s - target, v + a * s
+
+        return gap
 
     def describe(self) -> str:
         """``'20 x 10 box (centred on 0, 0)'``, with ``periodic`` when it is."""

@@ -1,0 +1,142 @@
+"""`Circle`: a circular vessel centred on the origin, with one wall, its rim.
+
+The rim's arithmetic used inside a run (time to the rim, contact point, reflection, the audit's
+outside test) is in `kernels/vessels/circle.py`. Angular momentum about the centre is conserved
+by the rim (`collidium.simulation.Simulation.angular_momentum`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any, ClassVar
+
+import numpy as np
+
+from collidium.errors import InputError
+from collidium.kernels.vessels import CIRCLE
+from collidium.kernels.vessels import circle as circle_walls
+from collidium.state import FloatArray, IntArray
+from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
+
+#: Corners of the polygon that stands for the rim in drawings.
+OUTLINE_CORNERS = 256
+
+
+class Circle(Vessel):
+    """The disk ``x^2 + y^2 <= radius^2`` (m), with reflecting walls.
+
+    Parameters
+    ----------
+    radius : float
+        The vessel's radius in m, > 0. A disk of radius r touches the rim when its centre is
+        ``radius - r`` from the origin.
+    """
+
+    kind: ClassVar[str] = "circle"
+    shape_code: ClassVar[int] = CIRCLE
+
+    def __init__(self, radius: float) -> None:
+        if not (isinstance(radius, int | float) and math.isfinite(radius) and radius > 0):
+            raise InputError("vessel.radius", f"must be a finite number > 0, got {radius!r}")
+        self.radius = float(radius)
+
+    @property
+    def wall_names(self) -> tuple[str, ...]:
+        """``("rim",)``."""
+        return ("rim",)
+
+    @property
+    def bounds(self) -> FloatArray:
+        """``[[-radius, -radius], [radius, radius]]`` in m."""
+        return np.array([[-self.radius, -self.radius], [self.radius, self.radius]])
+
+    @property
+    def area(self) -> float:
+        """``pi radius^2`` in m^2."""
+        return math.pi * self.radius**2
+
+    def outline(self) -> FloatArray:
+        """`OUTLINE_CORNERS` points of the rim, counter-clockwise from (radius, 0)."""
+        angle = np.linspace(0.0, 2.0 * math.pi, OUTLINE_CORNERS, endpoint=False)
+        return self.radius * np.column_stack([np.cos(angle), np.sin(angle)])
+
+    def available_area(self, radius: float) -> float:
+        """``pi (R - r)^2`` in m^2: the circle the centres of disks of radius r move in."""
+        return math.pi * (self.radius - radius) ** 2
+
+    def contact_lengths(self, radius: float) -> FloatArray:
+        """The rim's line of contact, ``2 pi (R - r)`` in m, shape (1,)."""
+        return np.array([2.0 * math.pi * (self.radius - radius)])
+
+    def outside(self, position: FloatArray, radius: FloatArray) -> IntArray:
+        """`Vessel.outside`: disks whose rim passes the vessel's by more than round-off."""
+        reach = np.hypot(position[:, 0], position[:, 1]) + radius
+        bad = ~(reach <= self.radius * (1.0 + OUTSIDE_TOLERANCE))  # NaN counts as outside
+        return np.flatnonzero(bad).astype(np.int64)
+
+    def check_fits(self, radius: FloatArray) -> None:
+        """Refuse disks whose diameter is not smaller than the vessel's radius (they would have
+        no room to move)."""
+        if radius.size and 2.0 * float(radius.max()) >= self.radius:
+            raise InputError(
+                "radius",
+                f"diameter {2.0 * float(radius.max())} must be smaller than the vessel's "
+                f"radius {self.radius}",
+            )
+
+    @property
+    def rim(self) -> float:
+        """The vessel's radius, m."""
+        return self.radius
+
+    def audit_limits(self, tolerance: float) -> tuple[float, float]:
+        """The radius with the round-off allowance, twice (m)."""
+        limit = self.radius * (1.0 + tolerance)
+        return limit, limit
+
+    def free_flight(
+        self,
+        position: FloatArray,
+        velocity: FloatArray,
+        radius: FloatArray,
+        mass: FloatArray,
+        image: IntArray,
+        dt: float,
+        wall_hits: IntArray,
+        wall_impulse: FloatArray,
+    ) -> None:
+        """`Vessel.free_flight`: straight lines reflected off the rim at the exact times they meet
+        it (`collidium.kernels.vessels.circle`)."""
+        circle_walls.drift_reflecting(
+            position, velocity, radius, mass, self.radius, dt, wall_hits, wall_impulse
+        )
+
+    def wall_gap(
+        self,
+        wall: int,
+        position: FloatArray,
+        velocity: FloatArray,
+        acceleration: FloatArray,
+        radius: float,
+    ) -> Callable[[float], tuple[float, float]]:
+        """`Vessel.wall_gap`: ``|x(s)|^2 - (R - r)^2`` (m^2), negative inside."""
+        x, v, a = (np.asarray(value, dtype=float) for value in (position, velocity, acceleration))
+        reach = self.radius - radius
+
+        def gap(s: float) -> tuple[float, float]:
+            at = x + (v + 0.5 * a * s) * s
+            return float(at @ at) - reach * reach, float(2.0 * at @ (v + a * s))
+
+        return gap
+
+    def describe(self) -> str:
+        """``'circle of radius 10 m (centred on 0, 0)'``."""
+        return f"circle of radius {self.radius:g} m (centred on 0, 0)"
+
+    def parameters(self) -> dict[str, Any]:
+        """``{"radius"}``, as in a scenario file."""
+        return {"radius": self.radius}
+
+    def __repr__(self) -> str:
+        return f"Circle({self.radius!r})"
