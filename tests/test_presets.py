@@ -76,7 +76,7 @@ def test_default_vessel_and_run(name):
     assert scenario.run.collisions == "exact"
     assert scenario.run.time == (60.0 if name == "pool-break" else 10.0)
     if name == "circle-gas":
-        assert scenario.vessel.model_dump() == {"shape": "circle", "radius": 11.3}
+        assert scenario.to_dict()["vessel"] == {"shape": "circle", "radius": 11.3}
         return
     assert scenario.vessel.boundary == "reflecting"
     size = (40.0, 20.0) if name == "pool-break" else (20.0, 20.0)

@@ -373,6 +373,7 @@ def _print_summary(summary: dict[str, Any]) -> None:
         ("angular momentum", f"{summary['angular_momentum']:.10g} kg m^2/s"),
         ("pair collisions", f"{summary['collisions']['pair']}"),
         ("wall collisions", f"{summary['collisions']['wall']}"),
+        *_heat_rows(summary["wall_heat"]),
         ("collision rate", _number(summary["collisions"]["rate"], "/s")),
         ("temperature kT", _number(summary["temperature"], "J")),
         ("wall pressure", _number(pressure["wall"], "N/m", pressure["wall_error"])),
@@ -386,6 +387,14 @@ def _print_summary(summary: dict[str, Any]) -> None:
     for row in rows:
         table.add_row(*row)
     Console().print(table)
+
+
+def _heat_rows(heat: dict[str, float]) -> list[tuple[str, str]]:
+    """A row of the energy the walls gave the gas, when any wall is not a mirror."""
+    if not any(heat.values()):
+        return []
+    each = ", ".join(f"{name} {value:.6g}" for name, value in heat.items() if value)
+    return [("wall heat (given to the gas)", f"{each} J")]
 
 
 def _number(value: float | None, unit: str, error: float | None = None) -> str:

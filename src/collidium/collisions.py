@@ -52,10 +52,14 @@ class Tally:
         The collision virial ``sum r_ij . dp_i`` over pair collisions (kg m^2/s; ``r_ij`` the
         centre-to-centre vector at contact, ``dp_i`` the impulse on i), then the normal momentum
         received by each wall, in the same order (kg m/s).
+    heat : ndarray of float64, shape (5,)
+        The energy each wall has given the disks (J; negative when it took energy), at the wall
+        entries of ``counts``; nonzero only for walls that are not mirrors.
     """
 
     counts: IntArray = field(default_factory=_zeros_int)
     impulse: FloatArray = field(default_factory=_zeros_float)
+    heat: FloatArray = field(default_factory=_zeros_float)
 
 
 @dataclass(frozen=True)
@@ -125,8 +129,9 @@ _NO_ACCELERATION = np.empty((0, 2))
 def _free_flight(particles: Particles, vessel: Vessel, dt: float, tally: Tally) -> None:
     p = particles
     vessel.free_flight(
-        p.position, p.velocity, p.radius, p.mass, p.image, dt, tally.counts[1:], tally.impulse[1:]
-    )
+        p.position, p.velocity, p.radius, p.mass, p.image, dt, tally.counts[1:],
+        tally.impulse[1:], tally.heat[1:],
+    )  # fmt: skip
 
 
 #: Vessel widths (its bounding box's shorter side) a particle may cross in one drift before the
@@ -318,6 +323,13 @@ class ExactCollisions:
         #: Events per particle between re-sorts of the engine's memory by cell (speed only).
         self.sort_interval = events.SORT_INTERVAL
         self._halt = np.full(events.HALT_SIZE, math.inf)
+        self._wall_table: tuple[Vessel, FloatArray] | None = None
+
+    def _walls(self, vessel: Vessel) -> FloatArray:
+        """The vessel's wall table, made once per vessel."""
+        if self._wall_table is None or self._wall_table[0] is not vessel:
+            self._wall_table = (vessel, vessel.wall_table())
+        return self._wall_table[1]
 
     def state(self) -> dict[str, np.ndarray]:
         """The event queue and lazily updated positions, and the event counters."""
@@ -406,7 +418,7 @@ class ExactCollisions:
             s["head"], s["next"], s["count"], s["event"], s["keys"], s["items"], s["where"],
             tally.counts, tally.impulse,
             _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
-            max(1, self.sort_interval * particles.n), halt,
+            max(1, self.sort_interval * particles.n), halt, self._walls(vessel), tally.heat,
         )  # fmt: skip
         if processed < 0:
             self._state = None  # the queue is unusable; a later drift rebuilds it

@@ -354,6 +354,7 @@ class _Snapshot:
         self.image = particles.image.copy()
         self.counts = tally.counts.copy()
         self.impulse = tally.impulse.copy()
+        self.heat = tally.heat.copy()
 
     def restore(self, particles: Particles, tally: Tally) -> None:
         """Put everything back as it was taken."""
@@ -362,3 +363,4 @@ class _Snapshot:
         particles.image[...] = self.image
         tally.counts[...] = self.counts
         tally.impulse[...] = self.impulse
+        tally.heat[...] = self.heat

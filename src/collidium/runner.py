@@ -29,6 +29,7 @@ from collidium.observers import (
     Thermo,
     Trigger,
 )
+from collidium.observers.energy import conserved_energy
 from collidium.scenario import build_observers
 from collidium.simulation import Simulation, restore_with_meta
 
@@ -236,7 +237,7 @@ def execute(sim: Simulation, job: Job, progress: bool = False) -> dict[str, Any]
     if remaining < 0:
         raise InputError("steps", f"the run is already past step {job.end_step}")
     if job.initial_total is None:
-        job.initial_total = sim.energy().total
+        job.initial_total = conserved_energy(sim)
     reported = [o for o in sim.observers if isinstance(o, Measurement)]
     period = max(1, remaining // SAMPLES)
     drift = EnergyDrift(reference=job.initial_total)

@@ -13,6 +13,10 @@ A scenario file::
     boundary = "reflecting"       # or "periodic" (box)
     # radius = 10.0               # m (circle)
 
+    [vessel.walls.left]           # a wall that is not a mirror, by name
+    response = "thermal"          # "specular" | "inelastic" (restitution = e) | "thermal"
+    temperature = 2.0             # kT of the wall, J
+
     [run]
     dt = 0.01                     # s, the reporting interval
     time = 10.0                   # s, default duration of `collidium run`
@@ -83,7 +87,16 @@ from collidium.observers import (
 )
 from collidium.simulation import Simulation, outside_detail, overlap_detail
 from collidium.state import FloatArray, Particles, uniform_or_each
-from collidium.vessels import VESSELS, Box, Circle, Vessel
+from collidium.vessels import (
+    VESSELS,
+    Box,
+    Circle,
+    Inelastic,
+    Specular,
+    Thermal,
+    Vessel,
+    WallResponse,
+)
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -132,10 +145,52 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True)
 
 
-class BoxSpec(_Model):
-    """A rectangular vessel centred on the origin, sides in m (`collidium.vessels.Box`)."""
+class SpecularSpec(_Model):
+    """A mirror wall (the default)."""
 
-    model_config = ConfigDict(extra="forbid", strict=True)
+    response: Literal["specular"]
+
+    def build(self) -> WallResponse:
+        """The `Specular` response."""
+        return Specular()
+
+
+class InelasticSpec(_Model):
+    """A wall that returns ``restitution`` (in (0, 1]) of the normal velocity."""
+
+    response: Literal["inelastic"]
+    restitution: Annotated[float, Field(gt=0.0, le=1.0)]
+
+    def build(self) -> WallResponse:
+        """The `Inelastic` response."""
+        return Inelastic(self.restitution)
+
+
+class ThermalSpec(_Model):
+    """A wall at temperature kT = ``temperature`` J that re-emits disks thermally."""
+
+    response: Literal["thermal"]
+    temperature: Positive
+
+    def build(self) -> WallResponse:
+        """The `Thermal` response."""
+        return Thermal(self.temperature)
+
+
+WallSpec = Annotated[SpecularSpec | InelasticSpec | ThermalSpec, Field(discriminator="response")]
+
+
+class _VesselSpec(_Model):
+    """What every vessel table has: the responses of walls that are not mirrors, by name."""
+
+    walls: dict[str, WallSpec] = Field(default_factory=dict)
+
+    def _walls(self) -> dict[str, WallResponse]:
+        return {name: spec.build() for name, spec in self.walls.items()}
+
+
+class BoxSpec(_VesselSpec):
+    """A rectangular vessel centred on the origin, sides in m (`collidium.vessels.Box`)."""
 
     shape: Literal["box"] = "box"
     width: Positive = 20.0
@@ -144,20 +199,18 @@ class BoxSpec(_Model):
 
     def build(self) -> Box:
         """The `Box` this describes."""
-        return Box(self.width, self.height, boundary=self.boundary)
+        return Box(self.width, self.height, boundary=self.boundary, walls=self._walls())
 
 
-class CircleSpec(_Model):
+class CircleSpec(_VesselSpec):
     """A circular vessel centred on the origin, radius in m (`collidium.vessels.Circle`)."""
-
-    model_config = ConfigDict(extra="forbid", strict=True)
 
     shape: Literal["circle"]
     radius: Positive = 10.0
 
     def build(self) -> Circle:
         """The `Circle` this describes."""
-        return Circle(self.radius)
+        return Circle(self.radius, walls=self._walls())
 
 
 def _shape_of(value: Any) -> str:
@@ -468,8 +521,12 @@ class RackGroup(_Model):
 
 Group = Annotated[ExplicitGroup | RandomGroup | RackGroup, Field(discriminator="kind")]
 
-#: Model of the vessel table, by its shape (for error messages).
+#: Model of the vessel table, by its shape, and of a wall's table, by its response (for error
+#: messages).
 _VESSEL_SPECS: dict[str, type[_Model]] = {"box": BoxSpec, "circle": CircleSpec}
+_WALL_SPECS: dict[str, type[_Model]] = {
+    "specular": SpecularSpec, "inelastic": InelasticSpec, "thermal": ThermalSpec,
+}  # fmt: skip
 
 #: Model of each table, by the discriminator value that selects it (for error messages).
 _TAGGED: dict[str, type[_Model]] = {
@@ -559,11 +616,13 @@ class Scenario(_Model):
         return cls.from_dict(parse_toml(text, source))
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data (Python floats, ints, str, lists, dicts); unset optional values and an empty
-        observer list left out."""
+        """Plain data (Python floats, ints, str, lists, dicts); unset optional values, an empty
+        observer list and an empty table of walls left out."""
         data = self.model_dump(mode="python", exclude_none=True)
         if not data["observers"]:
             del data["observers"]
+        if not data["vessel"]["walls"]:
+            del data["vessel"]["walls"]
         return data
 
     def to_toml(self) -> str:
@@ -805,17 +864,25 @@ def dump_toml(data: Mapping[str, Any]) -> str:
     Parameters
     ----------
     data : mapping
-        Values are str, bool, int, float, lists of those or of lists, one level of tables and
-        lists of tables (the shape of `Scenario.to_dict`).
+        Values are str, bool, int, float, lists of those or of lists, tables (nested tables
+        follow their parent, ``[vessel.walls.left]``) and lists of tables (the shape of
+        `Scenario.to_dict`).
     """
     scalars = {k: v for k, v in data.items() if not isinstance(v, Mapping) and not _is_tables(v)}
     chunks = [_toml_table(scalars)]
     for key, value in data.items():
         if isinstance(value, Mapping):
-            chunks.append(f"\n[{key}]\n{_toml_table(value)}")
+            chunks.append(_toml_section(key, value))
         elif _is_tables(value):
             chunks.extend(f"\n[[{key}]]\n{_toml_table(item)}" for item in value)
     return "".join(chunks)
+
+
+def _toml_section(path: str, table: Mapping[str, Any]) -> str:
+    """``[path]`` with the table's values, then its nested tables as ``[path.key]``."""
+    values = {k: v for k, v in table.items() if not isinstance(v, Mapping)}
+    nested = (_toml_section(f"{path}.{k}", v) for k, v in table.items() if isinstance(v, Mapping))
+    return f"\n[{path}]\n{_toml_table(values)}" + "".join(nested)
 
 
 def _is_tables(value: Any) -> bool:
@@ -906,13 +973,15 @@ def describe(exc: ValidationError) -> str:
 
 
 def _is_tag(loc: tuple[int | str, ...], k: int) -> bool:
-    """Whether ``loc[k]`` is a discriminator value pydantic inserted: a list entry's kind or the
-    vessel's shape."""
+    """Whether ``loc[k]`` is a discriminator value pydantic inserted: a list entry's kind, the
+    vessel's shape or a wall's response."""
     if k == 0:
         return False
     before = loc[k - 1]
-    return (isinstance(before, int) and loc[k] in _TAGGED) or (
-        before == "vessel" and k == 1 and loc[k] in _VESSEL_SPECS
+    return (
+        (isinstance(before, int) and loc[k] in _TAGGED)
+        or (before == "vessel" and k == 1 and loc[k] in _VESSEL_SPECS)
+        or (k >= 2 and loc[k - 2] == "walls" and loc[k] in _WALL_SPECS)
     )
 
 
@@ -985,7 +1054,8 @@ def _allowed_fields(loc: tuple[int | str, ...]) -> list[str]:
         if isinstance(part, int):
             model = None  # a list entry: its kind (the next part) decides the model
         elif _is_tag(loc, k):
-            model = _TAGGED[str(part)] if isinstance(loc[k - 1], int) else _VESSEL_SPECS[str(part)]
+            tables = _TAGGED if isinstance(loc[k - 1], int) else _VESSEL_SPECS
+            model = (_WALL_SPECS if k >= 2 and loc[k - 2] == "walls" else tables)[str(part)]
         elif k == 0 or isinstance(loc[k - 1], str):
             fields = model.model_fields if model is not None else {}
             if part not in fields:

@@ -344,6 +344,12 @@ class Simulation:
         hits = {name: int(self.tally.counts[1 + k]) for k, name in enumerate(names)}
         return Counters(int(self.tally.counts[0]), hits)
 
+    def wall_heat(self) -> dict[str, float]:
+        """Energy each wall has given the disks since the start, J, by wall name (negative when
+        it took energy; 0 for mirrors)."""
+        names = self.container.wall_names
+        return {name: float(self.tally.heat[1 + k]) for k, name in enumerate(names)}
+
     def escaped(self) -> int:
         """Number of particles outside the vessel (always 0 unless something is badly wrong)."""
         return int(self.container.outside(self.particles.position, self.particles.radius).size)
@@ -366,6 +372,7 @@ class Simulation:
             "angular_momentum": self.angular_momentum(),
             "total_speed": self.total_speed(),
             "collisions": {"pair": c.pair_collisions, "wall": c.wall_collisions},
+            "wall_heat": self.wall_heat(),
             "escaped": self.escaped(),
         }
 
@@ -384,6 +391,7 @@ class Simulation:
         arrays = {
             "position": p.position, "velocity": p.velocity, "image": p.image,
             "tally/counts": self.tally.counts, "tally/impulse": self.tally.impulse,
+            "tally/heat": self.tally.heat,
         } | properties | drift | integrator  # fmt: skip
         box = self.container
         state = {
@@ -461,6 +469,8 @@ def restore_with_meta(path: str | Path) -> tuple[Simulation, dict[str, Any]]:
         sim.rng.bit_generator.state = state["rng"]
         sim.tally.counts[...] = arrays["tally/counts"]
         sim.tally.impulse[...] = arrays["tally/impulse"]
+        if "tally/heat" in arrays:  # absent from checkpoints made before thermal walls
+            sim.tally.heat[...] = arrays["tally/heat"]
         sim._drift.load_state(
             {k.removeprefix("drift/"): v for k, v in arrays.items() if k.startswith("drift/")}
         )

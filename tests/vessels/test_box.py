@@ -39,7 +39,11 @@ def test_disks_too_large_for_the_box_are_refused():
 
 @pytest.mark.parametrize(
     ("args", "field"),
-    [((0, 10), "box.width"), ((10, -1), "box.height"), ((10, 10, "sticky"), "box.boundary")],
+    [
+        ((0, 10), "vessel.width"),
+        ((10, -1), "vessel.height"),
+        ((10, 10, "sticky"), "vessel.boundary"),
+    ],
 )
 def test_bad_box_names_the_field(args, field):
     with pytest.raises(InputError) as info:

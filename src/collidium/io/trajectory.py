@@ -49,6 +49,7 @@ LOG_KEYS = {
     "collisions/walls": "hits on each wall since the start, in the vessel's wall order",
     "impulse/virial": "collision virial sum r_ij . dp_i since the start, kg m^2/s",
     "impulse/walls": "momentum received by each wall, in the vessel's wall order, kg m/s",
+    "heat/walls": "energy each wall has given the disks (thermal, inelastic walls), J",
     "virial/forces": "pair virial of the forces now, J",
 }
 
@@ -103,6 +104,7 @@ def frame_of(sim: Simulation) -> gsd.hoomd.Frame:
         "collisions/walls": counts[1:],
         "impulse/virial": impulse[0],
         "impulse/walls": impulse[1:],
+        "heat/walls": sim.tally.heat[1:],
         "virial/forces": sim.virial(),
     }
     frame.log = {key: np.atleast_1d(np.asarray(value)) for key, value in values.items()}

@@ -43,6 +43,7 @@ import math
 import numba
 import numpy as np
 
+from collidium.kernels import wall_responses
 from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import elastic_response
 from collidium.kernels.vessels import CIRCLE, box, circle
@@ -581,6 +582,8 @@ def run_events(
     midpoint: float,
     sort_every: int,
     halt: np.ndarray,
+    walls: np.ndarray,
+    heat: np.ndarray,
 ) -> int:
     """Process every event up to time ``until`` (inclusive) in time order.
 
@@ -609,6 +612,10 @@ def run_events(
         the drift ran to ``until``. Infinity never halts. The engine's state is then part-way
         through the drift: the caller rebuilds it (`collidium.integrators` takes such a drift
         again, shorter, so that the contact falls between two substeps).
+    walls : ndarray, shape (W, 3)
+        The vessel's wall table (`collidium.kernels.wall_responses`): how each wall responds.
+    heat : ndarray of float64, shape (5,)
+        Incremented like ``impulse``'s wall entries by the energy each wall gives the disks (J).
     (other arrays)
         Engine state as built by `rebuild`; updated in place.
 
@@ -658,7 +665,8 @@ def run_events(
                               count, event)  # fmt: skip
                 heap_update(j, t_j, keys, items, where)
         elif code >= WALL_CODES[1]:
-            _bounce(k, -1 - code, t, body, ident, geometry, tally, impulse, acceleration, midpoint)
+            _bounce(k, -1 - code, t, body, ident, geometry, tally, impulse, acceleration, midpoint,
+                    walls, heat)  # fmt: skip
             count[k] += 1
         elif code >= CELL_CODES[1]:
             crossed = -5 - code
@@ -731,17 +739,34 @@ def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
 
 
 @_engine(inline="always")
-def _bounce(k, wall, t, body, ident, geometry, tally, impulse, acceleration, midpoint):
+def _bounce(k, wall, t, body, ident, geometry, tally, impulse, acceleration, midpoint, walls,
+            heat):  # fmt: skip
     """Slot k hits wall ``wall`` at time t (s): the box's 0 left, 1 right, 2 bottom, 3 top, or
     the circle's rim 0. The disk is first snapped to the contact point, so that round-off never
-    leaves it past the wall."""
+    leaves it past the wall; then the wall responds (``walls``, the vessel's wall table)."""
     _advance(k, t, body)
     r = _radius(k, body, geometry)
-    if geometry[SHAPE] == CIRCLE:
+    m = _mass(k, body, geometry)
+    circular = geometry[SHAPE] == CIRCLE
+    d, sign = 0, 1.0
+    if circular:
         x, y = circle.contact_point(body[k, X], body[k, Y], r, geometry[RIM])
         body[k, X] = x
         body[k, Y] = y
         nx, ny = circle.outward_normal(x, y)
+    else:
+        d = wall // 2
+        hw, hh = geometry[HALF_WIDTH], geometry[HALF_HEIGHT]
+        body[k, X + d] = box.contact_coordinate(wall, r, hw, hh)
+        sign = 1.0 if wall % 2 == 1 else -1.0
+        nx, ny = (sign, 0.0) if d == 0 else (0.0, sign)
+    if walls[wall, wall_responses.RESPONSE] != wall_responses.SPECULAR:
+        vx, vy = wall_responses.hit(walls, wall, body[k, VX], body[k, VY], nx, ny, m, ident[k],
+                                    tally, impulse, heat, WALL_HITS + wall)  # fmt: skip
+        body[k, VX] = vx
+        body[k, VY] = vy
+        return
+    if circular:
         outward = body[k, VX] * nx + body[k, VY] * ny
         pull = 0.0
         if acceleration.shape[0] > 0:
@@ -749,18 +774,14 @@ def _bounce(k, wall, t, body, ident, geometry, tally, impulse, acceleration, mid
         change = _wall_response(outward, pull, midpoint - t, acceleration.shape[0] > 0) - outward
         body[k, VX] += change * nx
         body[k, VY] += change * ny
-    else:  # the box: the normal is an axis, so the response is exact in floating point
-        d = wall // 2
-        hw, hh = geometry[HALF_WIDTH], geometry[HALF_HEIGHT]
-        body[k, X + d] = box.contact_coordinate(wall, r, hw, hh)
-        sign = 1.0 if wall % 2 == 1 else -1.0
+        impulse[WALL_HITS + wall] += m * abs(change)
+    else:  # a mirror of the box: the normal is an axis, so the response is exact
         before = body[k, VX + d]
         pull = acceleration[ident[k], d] if acceleration.shape[0] > 0 else 0.0
         after = sign * _wall_response(sign * before, sign * pull, midpoint - t,
                                       acceleration.shape[0] > 0)  # fmt: skip
-        change = after - before
         body[k, VX + d] = after
-    impulse[WALL_HITS + wall] += _mass(k, body, geometry) * abs(change)
+        impulse[WALL_HITS + wall] += m * abs(after - before)
     tally[WALL_HITS + wall] += 1
 
 

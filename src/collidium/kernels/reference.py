@@ -240,6 +240,41 @@ def circle_drift_reflecting(
     return bounces
 
 
+_MASK64 = (1 << 64) - 1
+
+
+def _mix64(z: int) -> int:
+    """SplitMix64's finaliser on Python integers (twin of `wall_responses._mix`)."""
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK64
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK64
+    return z ^ (z >> 31)
+
+
+def wall_uniform(key: int, particle: int, hit: int, draw: int) -> float:
+    """Twin of `wall_responses.uniform` in exact integer arithmetic."""
+    golden = 0x9E3779B97F4A7C15
+    z = _mix64((key + golden * (particle + 1)) & _MASK64)
+    z = _mix64((z + golden * (hit + 1)) & _MASK64)
+    z = _mix64((z + golden * (draw + 1)) & _MASK64)
+    return ((z >> 11) + 1) * 2.0**-53
+
+
+def wall_respond(
+    table: FloatArray, wall: int, outward: float, along: float, mass: float, particle: int, hit: int
+) -> tuple[float, float]:
+    """Twin of `wall_responses.respond`: mirror, restitution, or thermal re-emission (flux
+    Maxwell normal speed by inversion, Box-Muller tangential velocity)."""
+    code, parameter, key = table[wall]
+    if code == 1:
+        return -parameter * outward, along
+    if code == 2:
+        u = [wall_uniform(int(key), particle, hit, draw) for draw in range(3)]
+        normal = math.sqrt(-2.0 * parameter / mass * math.log(u[0]))
+        slide = math.sqrt(parameter / mass) * math.sqrt(-2.0 * math.log(u[1]))
+        return -normal, slide * math.cos(2.0 * math.pi * u[2])
+    return -outward, along
+
+
 def _next_contact(
     position: FloatArray, velocity: FloatArray, radius: FloatArray, size: FloatArray, periodic: bool
 ) -> tuple[float, int, int]:

@@ -135,6 +135,10 @@ def plot_energy(
 class EnergyDrift(Measurement):
     """Largest relative change of the total energy during a run, without storing a series.
 
+    What is conserved is the total energy less what the walls have given the disks (thermal and
+    inelastic walls, `collidium.simulation.Simulation.wall_heat`; nothing for mirrors), so that
+    is what is measured.
+
     Parameters
     ----------
     trigger : callable or int, optional
@@ -146,9 +150,9 @@ class EnergyDrift(Measurement):
     Attributes
     ----------
     initial_total : float
-        The reference energy in J.
+        The reference energy in J (less the walls' heat until then).
     max_rel_drift : float
-        ``max |E(t) - E_ref| / |E_ref|`` over the samples.
+        ``max |E(t) - Q(t) - E_ref| / |E_ref|`` over the samples, Q the walls' heat.
     """
 
     def __init__(
@@ -161,13 +165,20 @@ class EnergyDrift(Measurement):
 
     def _start(self, sim: Simulation) -> None:
         """Measure from the current energy (or the reference)."""
-        self.initial_total = sim.energy().total if self.reference is None else self.reference
+        self.initial_total = conserved_energy(sim) if self.reference is None else self.reference
         self.max_rel_drift = 0.0
 
     def _sample(self, sim: Simulation) -> None:
-        drift = abs(sim.energy().total - self.initial_total) / max(abs(self.initial_total), 1e-300)
+        scale = max(abs(self.initial_total), 1e-300)
+        drift = abs(conserved_energy(sim) - self.initial_total) / scale
         self.max_rel_drift = max(self.max_rel_drift, drift)
 
     def summary(self) -> dict[str, Any]:
         """Initial total energy and largest relative drift."""
         return {"initial_total": self.initial_total, "max_rel_drift": self.max_rel_drift}
+
+
+def conserved_energy(sim: Simulation) -> float:
+    """The total energy less the energy the walls have given the disks since the start, J: what
+    the dynamics conserve (the total energy itself with mirror walls)."""
+    return sim.energy().total - float(sum(sim.wall_heat().values()))

@@ -14,18 +14,34 @@ from collidium.errors import InputError
 from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
 from collidium.vessels.box import Box
 from collidium.vessels.circle import Circle
+from collidium.vessels.walls import Inelastic, Specular, Thermal, WallResponse, response_from_dict
 
 #: Vessel classes by their `Vessel.kind` (the ``shape`` of a scenario file or checkpoint).
 VESSELS: dict[str, type[Vessel]] = {cls.kind: cls for cls in (Box, Circle)}
 
 
 def vessel_from_dict(data: dict[str, Any]) -> Vessel:
-    """The vessel of `Vessel.to_dict`'s output: ``{"shape": kind, **parameters}``."""
+    """The vessel of `Vessel.to_dict`'s output: ``{"shape": kind, **parameters, "walls": ...}``."""
     parameters = dict(data)
     shape = parameters.pop("shape", "box")
     if shape not in VESSELS:
         raise InputError("vessel.shape", f"must be one of {tuple(VESSELS)}, got {shape!r}")
-    return VESSELS[shape](**parameters)
+    walls: dict[str, WallResponse] = {
+        name: response_from_dict(response, f"vessel.walls.{name}")
+        for name, response in parameters.pop("walls", {}).items()
+    }
+    return VESSELS[shape](**parameters, walls=walls)
 
 
-__all__ = ["OUTSIDE_TOLERANCE", "VESSELS", "Box", "Circle", "Vessel", "vessel_from_dict"]
+__all__ = [
+    "OUTSIDE_TOLERANCE",
+    "VESSELS",
+    "Box",
+    "Circle",
+    "Inelastic",
+    "Specular",
+    "Thermal",
+    "Vessel",
+    "WallResponse",
+    "vessel_from_dict",
+]

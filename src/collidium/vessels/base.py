@@ -11,6 +11,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from collidium.state import FloatArray, IntArray
+from collidium.vessels.walls import WallResponse, checked_walls, response_to_dict, wall_table
 
 #: Relative round-off allowance when deciding that a disk pokes out of a vessel.
 OUTSIDE_TOLERANCE = 1e-9
@@ -20,8 +21,16 @@ class Vessel(ABC):
     """A 2D container of disks, with named walls.
 
     A shape is one module of this package: a subclass registered in `collidium.vessels.VESSELS`
-    under its `kind`, with its fast arithmetic in a kernel file of its own.
+    under its `kind`, with its fast arithmetic in a kernel file of its own. Each wall has a
+    response (`collidium.vessels.walls`), specular unless the vessel's ``walls`` say otherwise.
     """
+
+    #: Responses of the walls that are not specular, by wall name.
+    walls: dict[str, WallResponse]
+
+    def __init__(self, walls: dict[str, WallResponse] | None = None) -> None:
+        """Keep the wall responses (after the shape has set what names its walls)."""
+        self.walls = checked_walls(self.wall_names, walls)
 
     #: The shape's name in scenario files and checkpoints (``shape: box``).
     kind: ClassVar[str]
@@ -120,11 +129,13 @@ class Vessel(ABC):
         dt: float,
         wall_hits: IntArray,
         wall_impulse: FloatArray,
+        wall_heat: FloatArray,
     ) -> None:
-        """Move every disk for ``dt`` s in straight lines, in place, with exact specular
-        reflections off the walls (or the periodic wrap), adding each wall's hits and the
-        momentum it receives (kg m/s) to ``wall_hits`` and ``wall_impulse`` (`wall_names`
-        order); ``image`` counts periodic wraps."""
+        """Move every disk for ``dt`` s in straight lines, in place, responding to the walls at
+        the exact times they are met (or wrapping periodically), adding each wall's hits, the
+        momentum it receives (kg m/s) and the energy it gives (J) to ``wall_hits``,
+        ``wall_impulse`` and ``wall_heat`` (`wall_names` order); ``image`` counts periodic
+        wraps."""
 
     @abstractmethod
     def wall_gap(
@@ -139,9 +150,15 @@ class Vessel(ABC):
         m/s, m/s^2) is from touching ``wall`` at time s: ``s -> (gap, d gap / ds)``, zero at
         contact and negative inside (in a unit of the shape's choosing), for Newton's method."""
 
+    def wall_table(self) -> FloatArray:
+        """The kernels' table of wall responses, one row per wall (`wall_names` order)."""
+        return wall_table(self.wall_names, self.walls)
+
     def to_dict(self) -> dict[str, Any]:
-        """`parameters` with the shape's name (``{"shape": kind, ...}``)."""
-        return {"shape": self.kind, **self.parameters()}
+        """`parameters` with the shape's name and any wall that is not specular
+        (``{"shape": kind, ..., "walls": {name: {"response": ...}}}``)."""
+        walls = {name: response_to_dict(response) for name, response in self.walls.items()}
+        return {"shape": self.kind, **self.parameters(), **({"walls": walls} if walls else {})}
 
     def wrap(self, position: FloatArray) -> FloatArray:
         """Positions mapped into the primary cell of a periodic vessel; an unchanged copy

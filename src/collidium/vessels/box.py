@@ -16,6 +16,7 @@ from collidium.kernels.vessels import BOX
 from collidium.kernels.vessels import box as box_walls
 from collidium.state import FloatArray, IntArray
 from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
+from collidium.vessels.walls import WallResponse
 
 Boundary = Literal["reflecting", "periodic"]
 BOUNDARIES: tuple[Boundary, ...] = ("reflecting", "periodic")
@@ -36,20 +37,29 @@ class Box(Vessel):
         radius r touches a wall when its centre is r away from it). ``"periodic"``: positions wrap,
         pairs and forces use the minimum image, unwrapped displacements are kept in
         ``Particles.image``; it has no walls.
+    walls : dict of str to WallResponse, optional
+        Responses of walls that are not mirrors, by name (``{"left": Thermal(2.0)}``).
     """
 
     kind: ClassVar[str] = "box"
     shape_code: ClassVar[int] = BOX
 
-    def __init__(self, width: float, height: float, boundary: Boundary = "reflecting") -> None:
+    def __init__(
+        self,
+        width: float,
+        height: float,
+        boundary: Boundary = "reflecting",
+        walls: dict[str, WallResponse] | None = None,
+    ) -> None:
         for name, value in (("width", width), ("height", height)):
             if not np.isfinite(value) or value <= 0:
-                raise InputError(f"box.{name}", f"must be a finite number > 0, got {value!r}")
+                raise InputError(f"vessel.{name}", f"must be a finite number > 0, got {value!r}")
         if boundary not in BOUNDARIES:
-            raise InputError("box.boundary", f"must be one of {BOUNDARIES}, got {boundary!r}")
+            raise InputError("vessel.boundary", f"must be one of {BOUNDARIES}, got {boundary!r}")
         self.width = float(width)
         self.height = float(height)
         self.boundary: Boundary = boundary
+        super().__init__(walls)
 
     @property
     def periodic(self) -> bool:
@@ -155,15 +165,22 @@ class Box(Vessel):
         dt: float,
         wall_hits: IntArray,
         wall_impulse: FloatArray,
+        wall_heat: FloatArray,
     ) -> None:
-        """`Vessel.free_flight`: the exact fold between the walls, or the periodic wrap
-        (`collidium.kernels.vessels.box`)."""
+        """`Vessel.free_flight`: the exact fold between mirror walls, hit by hit with other
+        responses, or the periodic wrap (`collidium.kernels.vessels.box`)."""
+        half_width, half_height = 0.5 * self.width, 0.5 * self.height
         if self.periodic:
             box_walls.drift_periodic(position, velocity, image, self.width, self.height, dt)
+        elif self.walls:
+            box_walls.drift_responding(
+                position, velocity, radius, mass, half_width, half_height, dt, self.wall_table(),
+                wall_hits, wall_impulse, wall_heat,
+            )  # fmt: skip
         else:
             box_walls.drift_reflecting(
-                position, velocity, radius, mass, 0.5 * self.width, 0.5 * self.height, dt,
-                wall_hits, wall_impulse,
+                position, velocity, radius, mass, half_width, half_height, dt, wall_hits,
+                wall_impulse,
             )  # fmt: skip
 
     def wall_gap(
@@ -192,7 +209,7 @@ class Box(Vessel):
         return f"{self.width:g} x {self.height:g} {periodic}box (centred on 0, 0)"
 
     def parameters(self) -> dict[str, Any]:
-        """``{"width", "height", "boundary"}``, as in a scenario file."""
+        """``{"width", "height", "boundary"}``, as in a scenario file (the walls apart)."""
         return {"width": self.width, "height": self.height, "boundary": self.boundary}
 
     def __repr__(self) -> str:

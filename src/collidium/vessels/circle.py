@@ -18,6 +18,7 @@ from collidium.kernels.vessels import CIRCLE
 from collidium.kernels.vessels import circle as circle_walls
 from collidium.state import FloatArray, IntArray
 from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
+from collidium.vessels.walls import WallResponse
 
 #: Corners of the polygon that stands for the rim in drawings.
 OUTLINE_CORNERS = 256
@@ -31,15 +32,18 @@ class Circle(Vessel):
     radius : float
         The vessel's radius in m, > 0. A disk of radius r touches the rim when its centre is
         ``radius - r`` from the origin.
+    walls : dict of str to WallResponse, optional
+        The rim's response if it is not a mirror (``{"rim": Inelastic(0.9)}``).
     """
 
     kind: ClassVar[str] = "circle"
     shape_code: ClassVar[int] = CIRCLE
 
-    def __init__(self, radius: float) -> None:
+    def __init__(self, radius: float, walls: dict[str, WallResponse] | None = None) -> None:
         if not (isinstance(radius, int | float) and math.isfinite(radius) and radius > 0):
             raise InputError("vessel.radius", f"must be a finite number > 0, got {radius!r}")
         self.radius = float(radius)
+        super().__init__(walls)
 
     @property
     def wall_names(self) -> tuple[str, ...]:
@@ -105,12 +109,14 @@ class Circle(Vessel):
         dt: float,
         wall_hits: IntArray,
         wall_impulse: FloatArray,
+        wall_heat: FloatArray,
     ) -> None:
-        """`Vessel.free_flight`: straight lines reflected off the rim at the exact times they meet
+        """`Vessel.free_flight`: straight lines, the rim responding at the exact times they meet
         it (`collidium.kernels.vessels.circle`)."""
-        circle_walls.drift_reflecting(
-            position, velocity, radius, mass, self.radius, dt, wall_hits, wall_impulse
-        )
+        circle_walls.drift_responding(
+            position, velocity, radius, mass, self.radius, dt, self.wall_table(), wall_hits,
+            wall_impulse, wall_heat,
+        )  # fmt: skip
 
     def wall_gap(
         self,
@@ -135,7 +141,7 @@ class Circle(Vessel):
         return f"circle of radius {self.radius:g} m (centred on 0, 0)"
 
     def parameters(self) -> dict[str, Any]:
-        """``{"radius"}``, as in a scenario file."""
+        """``{"radius"}``, as in a scenario file (the walls apart)."""
         return {"radius": self.radius}
 
     def __repr__(self) -> str:

@@ -16,6 +16,7 @@ import numpy as np
 
 from collidium import __version__
 from collidium.errors import InputError, SimulationError
+from collidium.observers.energy import conserved_energy
 from collidium.observers.speeds import SpeedHistogram
 from collidium.observers.thermo import Thermo
 from collidium.presets import PRESETS, describe_presets, preset
@@ -105,7 +106,7 @@ class ViewerSession:
 
     def _changed(self) -> None:
         """The state was changed from outside the dynamics: restart the drift and the windows."""
-        self._reference = self.sim.energy().total
+        self._reference = conserved_energy(self.sim)
         self._thermo = Thermo()
         self._pressure: float | None = None
         self._rate: float | None = None
@@ -300,7 +301,8 @@ class ViewerSession:
         energy = sim.energy()
         n = sim.particles.n
         kT = energy.kinetic / n if n else None
-        drift = (energy.total - self._reference) / abs(self._reference) if self._reference else None
+        conserved = conserved_energy(sim)
+        drift = (conserved - self._reference) / abs(self._reference) if self._reference else None
         return {
             "type": "stats", "time": sim.time, "steps": sim.steps, "n": n,
             "temperature": _number(kT), "pressure": self._pressure,

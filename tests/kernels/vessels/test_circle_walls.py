@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from collidium.kernels import reference
-from collidium.kernels.vessels.circle import contact_point, drift_reflecting, wall_delay
+from collidium.kernels.vessels.circle import contact_point, drift_responding, wall_delay
 
 RIM = 5.0
 
@@ -45,9 +45,10 @@ def test_flight_off_the_rim_equals_bounce_by_bounce_and_keeps_speed_and_angular_
     position = np.column_stack([distance * np.cos(angle), distance * np.sin(angle)])
     velocity = rng.normal(0, 10, (n, 2))
     mass = rng.uniform(0.5, 2.0, n)
-    hits, impulse = np.zeros(1, np.int64), np.zeros(1)
+    hits, impulse, heat = np.zeros(1, np.int64), np.zeros(1), np.zeros(1)
     x, v = position.copy(), velocity.copy()
-    drift_reflecting(x, v, radius, mass, RIM, 3.0, hits, impulse)
+    mirror = np.zeros((1, 3))
+    drift_responding(x, v, radius, mass, RIM, 3.0, mirror, hits, impulse, heat)
     twin_x, twin_v = position.copy(), velocity.copy()
     bounces = reference.circle_drift_reflecting(twin_x, twin_v, radius, RIM, 3.0)
     assert hits[0] == bounces > 3 * n  # 3 s at about 12 m/s, chords of about 8 m
@@ -58,3 +59,4 @@ def test_flight_off_the_rim_equals_bounce_by_bounce_and_keeps_speed_and_angular_
     after = x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]
     np.testing.assert_allclose(after, spin, rtol=1e-11, atol=1e-11)
     assert (np.hypot(*x.T) + radius <= RIM * (1 + 1e-12)).all()
+    assert abs(heat[0]) <= 1e-9 * np.sum(mass * np.hypot(*velocity.T) ** 2)  # a mirror

@@ -1,6 +1,6 @@
 """The circle's wall arithmetic, for every engine: the time to the rim and the contact point
-(exact engine), exact straight flight with reflections off the rim (step and off modes) and the
-outside test (audit).
+(exact engine), exact straight flight with the rim's response at each hit (step and off modes)
+and the outside test (audit).
 
 The circle is centred on the origin with radius ``rim`` (m); its one wall, the rim, is wall 0.
 A disk of radius r touches it when its centre is ``rim - r`` from the origin; the outward
@@ -13,6 +13,8 @@ import math
 
 import numba
 import numpy as np
+
+from collidium.kernels import wall_responses
 
 
 @numba.njit(cache=True, inline="always")
@@ -62,18 +64,21 @@ def reaches_outside(x: float, y: float, reach: float, limit: float) -> bool:
 
 
 @numba.njit(cache=True)
-def drift_reflecting(
+def drift_responding(
     position: np.ndarray,
     velocity: np.ndarray,
     radius: np.ndarray,
     mass: np.ndarray,
     rim: float,
     dt: float,
+    table: np.ndarray,
     wall_hits: np.ndarray,
     wall_impulse: np.ndarray,
+    wall_heat: np.ndarray,
 ) -> None:
-    """Move every particle for ``dt`` in straight lines, reflected specularly off the rim at the
-    exact times it is met, in index order (so the tallies do not depend on threads).
+    """Move every particle for ``dt`` in straight lines; at each exact time one meets the rim,
+    the rim's response (`collidium.kernels.wall_responses`; a mirror by default), in index order
+    (so the tallies do not depend on threads).
 
     Parameters
     ----------
@@ -85,10 +90,11 @@ def drift_reflecting(
         The circle's radius, m.
     dt : float
         Time step, s.
-    wall_hits : ndarray of int64, shape (1,)
-        Incremented per bounce off the rim.
-    wall_impulse : ndarray of float64, shape (1,)
-        Incremented by the momentum the rim receives along its normal, ``2 m |v_n|`` (kg m/s).
+    table : ndarray, shape (1, 3)
+        The rim's response.
+    wall_hits, wall_impulse, wall_heat : ndarray, shape (1,) or more
+        Incremented per hit on the rim: hits, momentum received along the normal (kg m/s),
+        energy given to the disk (J).
     """
     for i in range(position.shape[0]):
         left = dt
@@ -103,15 +109,12 @@ def drift_reflecting(
             x, y = contact_point(x + vx * delay, y + vy * delay, radius[i], rim)
             left -= delay
             nx, ny = outward_normal(x, y)
-            normal = vx * nx + vy * ny
-            if normal > 0.0:  # reflect what moves outwards; an inward grazer keeps going
-                vx -= 2.0 * normal * nx
-                vy -= 2.0 * normal * ny
-                wall_hits[0] += 1
-                wall_impulse[0] += 2.0 * mass[i] * normal
+            if vx * nx + vy * ny > 0.0:  # respond to what moves outwards
+                vx, vy = wall_responses.hit(table, 0, vx, vy, nx, ny, mass[i], i, wall_hits,
+                                            wall_impulse, wall_heat, 0)  # fmt: skip
             elif delay == 0.0:
-                # Exactly tangent at the rim (only round-off makes it): no reflection to make;
-                # go on along the rim's chord-free tangent and keep the centre on the circle.
+                # Exactly tangent at the rim (only round-off makes it): nothing to respond to;
+                # go on along the tangent and keep the centre on the circle.
                 x, y = contact_point(x + vx * left, y + vy * left, radius[i], rim)
                 break
         position[i, 0], position[i, 1] = x, y
