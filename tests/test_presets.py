@@ -3,6 +3,8 @@ them), overrides, the registry."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -24,6 +26,7 @@ SECTIONS = {
     "pool-break": "4.1.1",
     "charged-no-collisions": "4.2.1",
     "circle-gas": "5",
+    "heat-flow": "5",
 }
 
 # name -> (positions, velocities, masses, charges, radius, Coulomb (k, softening) or None)
@@ -74,12 +77,12 @@ def test_default_vessel_and_run(name):
     assert scenario.name == name
     assert scenario.run.dt == 0.01
     assert scenario.run.collisions == "exact"
-    assert scenario.run.time == (60.0 if name == "pool-break" else 10.0)
+    assert scenario.run.time == (60.0 if name in ("pool-break", "heat-flow") else 10.0)
     if name == "circle-gas":
         assert scenario.to_dict()["vessel"] == {"shape": "circle", "radius": 11.3}
         return
     assert scenario.vessel.boundary == "reflecting"
-    size = (40.0, 20.0) if name == "pool-break" else (20.0, 20.0)
+    size = {"pool-break": (40.0, 20.0), "heat-flow": (40.0, 10.0)}.get(name, (20.0, 20.0))
     assert (scenario.vessel.width, scenario.vessel.height) == size
 
 
@@ -109,6 +112,19 @@ def test_circle_gas_is_the_gas_in_a_circle_and_keeps_its_angular_momentum():
     sim.run(time=10.0)
     assert sim.counters.wall_hits["rim"] > 100 and sim.escaped() == 0
     assert sim.angular_momentum() == pytest.approx(spin, rel=1e-10, abs=1e-10)
+
+
+def test_heat_flow_carries_heat_from_the_hot_wall_to_the_cold_one_down_a_temperature_slope():
+    sim = preset("heat-flow", n=200).build()
+    (profile,) = sim.observers
+    sim.run(time=60.0)
+    heat = sim.wall_heat()
+    assert heat["left"] > 0 > heat["right"] and heat["top"] == heat["bottom"] == 0.0
+    kT, error = profile.temperature, profile.temperature_error()
+    # Hotter near the hot wall than near the cold one, by many standard errors ...
+    assert kT[0] - kT[-1] > 5 * math.hypot(error[0], error[-1])
+    # ... and between the two walls' temperatures, as a conducting gas must be.
+    assert 5.0 < kT[-1] < kT[0] < 30.0
 
 
 @pytest.mark.parametrize("name", ["gas", "charged-gas"])

@@ -17,7 +17,7 @@ from __future__ import annotations
 import inspect
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from collidium.errors import InputError
 from collidium.integrators import DEFAULT_TOLERANCE
@@ -28,8 +28,11 @@ if TYPE_CHECKING:
 PresetFunction = Callable[..., "Scenario"]
 Particles = list[dict[str, Any]]
 #: Builds a preset's particle groups: positional parameters are shared settings it needs
-#: (``mass``, ``radius``...), keyword-only ones (with defaults) are the preset's own knobs.
-Builder = Callable[..., Particles]
+#: (``mass``, ``radius``...), keyword-only ones (with defaults) are the preset's own knobs. A
+#: preset that needs more returns a dict: ``particles``, and any of ``walls`` (the vessel's wall
+#: tables by name) and ``observers`` (observer tables).
+Builder = Callable[..., Particles | dict[str, Any]]
+AnyBuilder = TypeVar("AnyBuilder", bound=Builder)
 
 #: The shared settings with their usual defaults, in the order presets list them.
 _COMMON: dict[str, Any] = {
@@ -83,13 +86,13 @@ def _preset(
     common: tuple[str, ...] = _NEUTRAL,
     title: str | None = None,
     **defaults: Any,
-) -> Callable[[Builder], Builder]:
+) -> Callable[[AnyBuilder], AnyBuilder]:
     """Register a preset under ``name``: it takes the shared settings ``common`` (with
     ``defaults`` replacing the usual ones) and the keyword-only parameters of its builder."""
     if not set(defaults) <= set(common) <= set(_COMMON):
         raise ValueError(f"preset {name!r}: unknown shared setting or default")
 
-    def register(build: Builder) -> Builder:
+    def register(build: AnyBuilder) -> AnyBuilder:
         signature = inspect.signature(build).parameters.values()
         knobs = {p.name: p.default for p in signature if p.kind is p.KEYWORD_ONLY}
         shared = {key: defaults.get(key, value) for key, value in _COMMON.items() if key in common}
@@ -100,7 +103,7 @@ def _preset(
     return register
 
 
-def _charged(name: str, section: str, description: str) -> Callable[[Builder], Builder]:
+def _charged(name: str, section: str, description: str) -> Callable[[AnyBuilder], AnyBuilder]:
     """Register a preset of charges with a Coulomb force and the usual shared settings."""
     return _preset(name, section, description, common=_CHARGED)
 
@@ -111,7 +114,8 @@ def _scenario(name: str, values: dict[str, Any]) -> Scenario:
 
     entry = _ENTRIES[name]
     arguments = inspect.signature(entry.build).parameters
-    particles = entry.build(**{key: values[key] for key in arguments})
+    built = entry.build(**{key: values[key] for key in arguments})
+    parts = built if isinstance(built, dict) else {"particles": built}
     title = entry.description if entry.title is None else entry.title.format(**values)
     forces = []
     if "k" in entry.parameters:
@@ -121,12 +125,14 @@ def _scenario(name: str, values: dict[str, Any]) -> Scenario:
             "name": name,
             "description": title,
             "seed": values["seed"],
-            "vessel": _vessel(entry, values),
+            "vessel": _vessel(entry, values)
+            | ({"walls": parts["walls"]} if "walls" in parts else {}),
             "run": {
                 key: values[key] for key in ("dt", "time", "collisions", "integrator", "tolerance")
             },
             "forces": forces,
-            "particles": particles,
+            "particles": parts["particles"],
+            "observers": parts.get("observers", []),
         }
     )
 
@@ -284,6 +290,34 @@ def circle_gas(mass: float, radius: float, *, n: int = 200, speed: float = 10.0)
     angular momentum about the centre as well as the energy (the seed's future work: other
     shapes of vessel)."""
     return gas(mass, radius, n=n, speed=speed)
+
+
+@_preset(
+    "heat-flow",
+    "5",
+    "a gas between a hot wall (left) and a cold one (right): a temperature profile, heat flux",
+    common=(*_NEUTRAL, "boundary"),
+    title="{n} disks between walls at kT = {hot:g} J (left) and {cold:g} J (right)",
+    width=40.0,
+    height=10.0,
+    time=60.0,
+)
+def heat_flow(
+    mass: float, radius: float, *, n: int = 300, speed: float = 7.0, hot: float = 30.0,
+    cold: float = 5.0,
+) -> dict[str, Any]:  # fmt: skip
+    """``n`` disks at random (velocity components uniform in ``[-speed, speed]`` m/s) in a
+    40 m x 10 m box whose left wall is thermal at kT = ``hot`` J and right wall at ``cold`` J
+    (the top and bottom are mirrors). Heat flows from left to right (``wall_heat``); a
+    temperature profile in 10 slices along x is measured after 20 s."""
+    return {
+        "particles": gas(mass, radius, n=n, speed=speed),
+        "walls": {
+            "left": {"response": "thermal", "temperature": hot},
+            "right": {"response": "thermal", "temperature": cold},
+        },
+        "observers": [{"kind": "profile", "bins": 10, "axis": "x", "after": 20.0, "every": 10}],
+    }
 
 
 def presets() -> list[str]:

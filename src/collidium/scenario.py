@@ -35,8 +35,8 @@ A scenario file::
     speed = 10.0                  # velocity components uniform in [-speed, speed], m/s
 
     [[observers]]                 # measurements and writers attached to the simulation
-    kind = "speeds"               # "energy" | "speeds" | "thermo" | "collisions" | "tracer" |
-    interval = 0.5                # "trajectory"; fired every `every` steps or `interval` s,
+    kind = "speeds"               # "energy" | "speeds" | "thermo" | "profile" | "collisions" |
+    interval = 0.5                # "tracer" | "trajectory"; every `every` steps or `interval` s,
     after = 5.0                   # from time `after` on
 
 `Scenario.build` turns it into a `Simulation`; the random groups draw, in group order, from one
@@ -81,6 +81,7 @@ from collidium.observers import (
     Interval,
     Observer,
     SpeedHistogram,
+    TemperatureProfile,
     Thermo,
     Tracer,
     Trigger,
@@ -324,6 +325,18 @@ class ThermoSpec(_ObserverSpec):
         return Thermo(self.trigger())
 
 
+class ProfileSpec(_ObserverSpec):
+    """`TemperatureProfile`: kT in ``bins`` slices across ``axis``."""
+
+    kind: Literal["profile"] = "profile"
+    bins: Annotated[int, Field(ge=1, le=10_000)] = 10
+    axis: Literal["x", "y"] = "x"
+
+    def build(self) -> Observer:
+        """The observer this describes."""
+        return TemperatureProfile(self.bins, self.axis, self.trigger())
+
+
 class CollisionsSpec(_ObserverSpec):
     """`CollisionRate`: collision rate, mean free time and path."""
 
@@ -366,7 +379,13 @@ class TrajectorySpec(_ObserverSpec):
 
 
 ObserverSpec = Annotated[
-    EnergySpec | SpeedsSpec | ThermoSpec | CollisionsSpec | TracerSpec | TrajectorySpec,
+    EnergySpec
+    | SpeedsSpec
+    | ThermoSpec
+    | ProfileSpec
+    | CollisionsSpec
+    | TracerSpec
+    | TrajectorySpec,
     Field(discriminator="kind"),
 ]
 
@@ -537,6 +556,7 @@ _TAGGED: dict[str, type[_Model]] = {
     "energy": EnergySpec,
     "speeds": SpeedsSpec,
     "thermo": ThermoSpec,
+    "profile": ProfileSpec,
     "collisions": CollisionsSpec,
     "tracer": TracerSpec,
     "trajectory": TrajectorySpec,

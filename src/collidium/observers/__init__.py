@@ -10,6 +10,7 @@ from collidium.observers.base import After, Every, Interval, Measurement, Observ
 from collidium.observers.counters import CollisionRate
 from collidium.observers.energy import EnergyDrift, EnergySeries
 from collidium.observers.paths import Tracer
+from collidium.observers.profile import TemperatureProfile
 from collidium.observers.speeds import SpeedHistogram
 from collidium.observers.thermo import Thermo
 
@@ -23,6 +24,7 @@ __all__ = [
     "Measurement",
     "Observer",
     "SpeedHistogram",
+    "TemperatureProfile",
     "Thermo",
     "Tracer",
     "Trigger",
