@@ -26,6 +26,7 @@ SECTIONS = {
     "pool-break": "4.1.1",
     "charged-no-collisions": "4.2.1",
     "circle-gas": "5",
+    "pi-blocks": "5",
     "heat-flow": "5",
 }
 
@@ -112,6 +113,26 @@ def test_circle_gas_is_the_gas_in_a_circle_and_keeps_its_angular_momentum():
     sim.run(time=10.0)
     assert sim.counters.wall_hits["rim"] > 100 and sim.escaped() == 0
     assert sim.angular_momentum() == pytest.approx(spin, rel=1e-10, abs=1e-10)
+
+
+PI = "314159265"
+
+
+@pytest.mark.parametrize("digits", range(8))
+def test_pi_blocks_count_the_digits_of_pi(digits):
+    """Galperin's billiard: with a mass ratio 100^d the collisions (pair and wall) number the
+    first d + 1 digits of pi; exact counts, nothing approximate."""
+    sim = preset("pi-blocks", digits=digits).build().run(time=10.0)
+    counters = sim.counters
+    assert counters.pair_collisions + counters.wall_collisions == int(PI[: digits + 1])
+    assert counters.wall_hits["right"] == 0  # the run ends before the heavy block gets there
+    velocity = sim.particles.velocity[:, 0]
+    assert 0.0 <= velocity[0] <= velocity[1]  # both leave to the right, the light one slower
+
+
+def test_pi_blocks_refuse_digits_beyond_double_precision():
+    with pytest.raises(InputError, match="digits: must be a whole number from 0 to 8"):
+        preset("pi-blocks", digits=9)
 
 
 def test_heat_flow_carries_heat_from_the_hot_wall_to_the_cold_one_down_a_temperature_slope():

@@ -373,6 +373,7 @@ def _print_summary(summary: dict[str, Any]) -> None:
         ("angular momentum", f"{summary['angular_momentum']:.10g} kg m^2/s"),
         ("pair collisions", f"{summary['collisions']['pair']}"),
         ("wall collisions", f"{summary['collisions']['wall']}"),
+        ("all collisions", f"{summary['collisions']['pair'] + summary['collisions']['wall']}"),
         *_heat_rows(summary["wall_heat"]),
         ("collision rate", _number(summary["collisions"]["rate"], "/s")),
         ("temperature kT", _number(summary["temperature"], "J")),
