@@ -27,6 +27,7 @@ SECTIONS = {
     "charged-no-collisions": "4.2.1",
     "circle-gas": "5",
     "pi-blocks": "5",
+    "brownian": "5",
     "heat-flow": "5",
 }
 
@@ -78,9 +79,14 @@ def test_default_vessel_and_run(name):
     assert scenario.name == name
     assert scenario.run.dt == 0.01
     assert scenario.run.collisions == "exact"
-    assert scenario.run.time == (60.0 if name in ("pool-break", "heat-flow") else 10.0)
+    times = {"pool-break": 60.0, "heat-flow": 60.0, "brownian": 300.0}
+    assert scenario.run.time == times.get(name, 10.0)
     if name == "circle-gas":
         assert scenario.to_dict()["vessel"] == {"shape": "circle", "radius": 11.3}
+        return
+    if name == "brownian":  # a periodic box, for a walk longer than a box
+        assert scenario.to_dict()["vessel"] == {"shape": "box", "width": 40.0, "height": 40.0,
+                                                "boundary": "periodic"}  # fmt: skip
         return
     assert scenario.vessel.boundary == "reflecting"
     size = {"pool-break": (40.0, 20.0), "heat-flow": (40.0, 10.0)}.get(name, (20.0, 20.0))
@@ -133,6 +139,24 @@ def test_pi_blocks_count_the_digits_of_pi(digits):
 def test_pi_blocks_refuse_digits_beyond_double_precision():
     with pytest.raises(InputError, match="digits: must be a whole number from 0 to 8"):
         preset("pi-blocks", digits=9)
+
+
+def test_the_brownian_disk_takes_the_gas_temperature_and_wanders():
+    """Equipartition: the heavy disk's mean kinetic energy is the gas's kT (2D, Boltzmann's
+    constant 1), within 3 standard errors of block averages; and it diffuses."""
+    sim = preset("brownian").build()
+    (tracer,) = sim.observers
+    sim.run(time=10.0)  # the small disks kick the heavy one up to their temperature
+    energy = []
+    for _ in range(2000):
+        sim.run(steps=5)
+        v = sim.particles.velocity[0]
+        energy.append(0.5 * sim.particles.mass[0] * float(v @ v))
+    blocks = [np.mean(b) for b in np.array_split(energy, 20)]
+    error = np.std(blocks, ddof=1) / math.sqrt(20)
+    assert abs(np.mean(energy) - sim.temperature()) < 3 * error
+    assert tracer.diffusion_coefficient() > 0.2 and tracer.msd()[-1] > 50.0
+    assert sim.particles.radius[0] == 1.0 and sim.escaped() == 0
 
 
 def test_heat_flow_carries_heat_from_the_hot_wall_to_the_cold_one_down_a_temperature_slope():

@@ -316,6 +316,35 @@ def pi_blocks(mass: float, radius: float, *, digits: int = 5, speed: float = 1.0
 
 
 @_preset(
+    "brownian",
+    "5",
+    "one heavy large disk among 2000 small ones: a random walk, traced; its MSD slope gives D",
+    common=(*_NEUTRAL, "boundary"),
+    title="a disk of {heavy_mass:g} kg and radius {heavy_radius:g} m among {n} small ones",
+    radius=0.1,
+    width=40.0,
+    height=40.0,
+    boundary="periodic",
+    time=300.0,
+)
+def brownian(
+    mass: float, radius: float, *, n: int = 2000, speed: float = 10.0, heavy_mass: float = 50.0,
+    heavy_radius: float = 1.0,
+) -> dict[str, Any]:  # fmt: skip
+    """A disk of ``heavy_mass`` kg and ``heavy_radius`` m at rest at the origin (particle 0)
+    among ``n`` small disks at random (velocity components uniform in ``[-speed, speed]`` m/s)
+    in a periodic 40 m x 40 m box; a tracer follows it. Kicked by the small ones it takes their
+    temperature and wanders: its mean-square displacement grows as ``4 D t``. One walk gives D
+    to within a factor of about two in the default 300 s; longer runs or several seeds narrow
+    it."""
+    heavy = _pair([[0.0, 0.0]], [[0.0, 0.0]], heavy_mass, heavy_radius)
+    return {
+        "particles": [heavy, *gas(mass, radius, n=n, speed=speed)],
+        "observers": [{"kind": "tracer", "particles": [0], "every": 10}],
+    }
+
+
+@_preset(
     "heat-flow",
     "5",
     "a gas between a hot wall (left) and a cold one (right): a temperature profile, heat flux",
