@@ -393,10 +393,9 @@ class Simulation:
             "tally/counts": self.tally.counts, "tally/impulse": self.tally.impulse,
             "tally/heat": self.tally.heat,
         } | properties | drift | integrator  # fmt: skip
-        box = self.container
         state = {
             "name": self.name,
-            "vessel": box.to_dict(),
+            "vessel": self.container.to_dict(),
             "forces": [force.to_dict() for force in self.forces],
             "dt": self._dt,
             "time_origin": list(self._time_origin),
