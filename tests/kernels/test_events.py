@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from collidium import Box, Particles, Simulation, collisions
+from collidium import Box, Circle, Particles, Simulation, collisions
 from collidium.kernels import events, reference
 from collidium.kernels.events import contact_delay
 from conftest import jittered_lattice
@@ -66,6 +66,30 @@ def test_engine_matches_brute_force_twin(rng, boundary, width, duration):
     assert sim.counters.wall_collisions == walls
     np.testing.assert_allclose(sim.tally.impulse, [virial, *wall_impulse], rtol=1e-9)
     np.testing.assert_allclose(sim.unwrapped_position(), twin_position, rtol=0, atol=1e-9 * width)
+    np.testing.assert_allclose(sim.particles.velocity, twin_velocity, rtol=0, atol=1e-8 * 10)
+
+
+def test_engine_matches_brute_force_twin_in_a_circle(rng):
+    """The rim as an event: same collisions, rim hits and impulses, same final state as the
+    all-pairs twin, to the round-off growth of a chaotic gas."""
+    rim = 10.0
+    position = jittered_lattice(10, 1.3 * rim, 0.4, rng)  # corners at 0.92 of the rim
+    n = len(position)
+    velocity = rng.uniform(-10, 10, (n, 2))
+    mass = rng.uniform(0.5, 2.0, n)
+    radius = rng.uniform(0.1, 0.4, n)
+    sim = Simulation(
+        Circle(rim), Particles(position.copy(), velocity.copy(), mass=mass, radius=radius), dt=0.1
+    )
+    sim.run(steps=7)
+    twin_position, twin_velocity = position.copy(), velocity.copy()
+    pairs, walls, virial, wall_impulse = reference.event_drift(
+        twin_position, twin_velocity, mass, radius, np.array([rim, rim]), 0.7, rim=rim
+    )
+    assert pairs > 5 and walls > 5
+    assert (sim.counters.pair_collisions, sim.counters.wall_hits["rim"]) == (pairs, walls)
+    np.testing.assert_allclose(sim.tally.impulse[:2], [virial, *wall_impulse], rtol=1e-9)
+    np.testing.assert_allclose(sim.particles.position, twin_position, rtol=0, atol=1e-9 * rim)
     np.testing.assert_allclose(sim.particles.velocity, twin_velocity, rtol=0, atol=1e-8 * 10)
 
 

@@ -142,29 +142,40 @@ def event_drift(
     half: FloatArray,
     duration: float,
     periodic: bool = False,
+    rim: float | None = None,
 ) -> tuple[int, int, float, FloatArray]:
-    """Event-driven hard disks, all pairs (and, if periodic, all 9 images) checked at every event.
+    """Event-driven hard disks, all pairs (and, if periodic, all 9 images) checked at every event,
+    in a box of half sides ``half`` or, with ``rim``, in a circle of that radius (m).
 
     Positions and velocities (N, 2) are updated in place (periodic positions are left unwrapped).
     Returns (pair collisions, wall hits, collision virial ``sum r_ij . dp_i``, momentum received
-    by the left, right, bottom and top wall).
+    by the left, right, bottom and top wall, or by the rim).
     """
     now = 0.0
     pairs = walls = 0
     virial = 0.0
-    wall_impulse = np.zeros(4)
+    wall_impulse = np.zeros(4 if rim is None else 1)
     while True:
         t_pair, i, j = _next_contact(position, velocity, radius, 2 * half, periodic)
-        t_wall, k, d = (
-            (math.inf, -1, -1) if periodic else _next_wall(position, velocity, radius, half)
-        )
+        if periodic:
+            t_wall, k, d = math.inf, -1, -1
+        elif rim is not None:
+            t_wall, k, d = _next_rim(position, velocity, radius, rim)
+        else:
+            t_wall, k, d = _next_wall(position, velocity, radius, half)
         best = min(t_pair, t_wall)
         if now + best > duration:
             position += velocity * (duration - now)
             return pairs, walls, virial, wall_impulse
         position += velocity * best
         now += best
-        if t_wall < t_pair:
+        if t_wall < t_pair and rim is not None:
+            normal = position[k] / np.linalg.norm(position[k])
+            outward = float(velocity[k] @ normal)
+            wall_impulse[0] += 2 * mass[k] * abs(outward)
+            velocity[k] -= 2 * outward * normal
+            walls += 1
+        elif t_wall < t_pair:
             wall_impulse[2 * d + (1 if velocity[k, d] > 0 else 0)] += (
                 2 * mass[k] * abs(velocity[k, d])
             )
@@ -180,6 +191,18 @@ def event_drift(
             )
             virial += mass[i] * np.dot(sep, velocity[i] - before)
             pairs += 1
+
+
+def _next_rim(
+    position: FloatArray, velocity: FloatArray, radius: FloatArray, rim: float
+) -> tuple[float, int, int]:
+    """Earliest contact with a circle's rim: (delay, particle, 0)."""
+    delays = [
+        circle_wall_delay(x, v, r, rim)[0]
+        for x, v, r in zip(position, velocity, radius, strict=True)
+    ]
+    k = int(np.argmin(delays))
+    return float(delays[k]), k, 0
 
 
 def _next_wall(
