@@ -1,0 +1,46 @@
+"""Never an escape: every shape, a dense gas (packing 0.6) started on a hexagonal lattice with one
+disk at 1000 m/s, ten million collisions."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from collidium import Box, Circle, Particles, Simulation
+from collidium.vessels import Vessel
+
+RADIUS = 0.25
+PACKING = 0.6
+
+
+def hexagonal_inside(vessel: Vessel, rng: np.random.Generator) -> np.ndarray:
+    """Centres of a hexagonal lattice at `PACKING` (of the plane), those whose disk is inside."""
+    spacing = RADIUS * math.sqrt(2 * math.pi / (math.sqrt(3) * PACKING))
+    (x0, y0), (x1, y1) = vessel.bounds
+    rows = np.arange(y0, y1, spacing * math.sqrt(3) / 2)
+    points = [(x + (k % 2) * spacing / 2, y) for k, y in enumerate(rows)
+              for x in np.arange(x0, x1, spacing)]  # fmt: skip
+    centres = np.array(points)
+    inside = np.ones(len(centres), dtype=bool)
+    inside[vessel.outside(centres, np.full(len(centres), RADIUS * (1 + 1e-6)))] = False
+    return centres[inside]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("vessel", [Box(24.0, 24.0), Circle(13.5)], ids=["box", "circle"])
+def test_ten_million_collisions_at_packing_0_6_with_a_disk_at_1000_m_per_s(vessel, rng):
+    position = hexagonal_inside(vessel, rng)
+    n = len(position)
+    velocity = rng.normal(0.0, 1.0, (n, 2))
+    velocity[n // 2] = [1000.0 * math.cos(0.3), 1000.0 * math.sin(0.3)]
+    sim = Simulation(vessel, Particles(position, velocity, radius=RADIUS), dt=1.0)
+    assert math.pi * RADIUS**2 * n / vessel.available_area(RADIUS) > 0.55  # dense
+    energy = sim.energy().total
+    while sim.counters.pair_collisions < 10_000_000:
+        sim.run(steps=1)  # the audit checks after every step that nobody left
+    assert sim.escaped() == 0
+    assert sim.counters.wall_collisions > 10_000
+    # Ten million roundings of ~1e-16 relative each, as a random walk.
+    assert abs(sim.energy().total - energy) <= 1e-12 * energy
