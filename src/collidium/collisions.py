@@ -323,13 +323,6 @@ class ExactCollisions:
         #: Events per particle between re-sorts of the engine's memory by cell (speed only).
         self.sort_interval = events.SORT_INTERVAL
         self._halt = np.full(events.HALT_SIZE, math.inf)
-        self._wall_table: tuple[Vessel, FloatArray] | None = None
-
-    def _walls(self, vessel: Vessel) -> FloatArray:
-        """The vessel's wall table, made once per vessel."""
-        if self._wall_table is None or self._wall_table[0] is not vessel:
-            self._wall_table = (vessel, vessel.wall_table())
-        return self._wall_table[1]
 
     def state(self) -> dict[str, np.ndarray]:
         """The event queue and lazily updated positions, and the event counters."""
@@ -418,7 +411,7 @@ class ExactCollisions:
             s["head"], s["next"], s["count"], s["event"], s["keys"], s["items"], s["where"],
             tally.counts, tally.impulse,
             _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
-            max(1, self.sort_interval * particles.n), halt, self._walls(vessel), tally.heat,
+            max(1, self.sort_interval * particles.n), halt, vessel.wall_table(), tally.heat,
         )  # fmt: skip
         if processed < 0:
             self._state = None  # the queue is unusable; a later drift rebuilds it

@@ -29,8 +29,10 @@ class Vessel(ABC):
     walls: dict[str, WallResponse]
 
     def __init__(self, walls: dict[str, WallResponse] | None = None) -> None:
-        """Keep the wall responses (after the shape has set what names its walls)."""
+        """Keep the wall responses (after the shape has set what names its walls) and the
+        kernels' table of them, made once: a vessel does not change."""
         self.walls = checked_walls(self.wall_names, walls)
+        self._wall_table = wall_table(self.wall_names, self.walls)
 
     #: The shape's name in scenario files and checkpoints (``shape: box``).
     kind: ClassVar[str]
@@ -152,7 +154,7 @@ class Vessel(ABC):
 
     def wall_table(self) -> FloatArray:
         """The kernels' table of wall responses, one row per wall (`wall_names` order)."""
-        return wall_table(self.wall_names, self.walls)
+        return self._wall_table
 
     def to_dict(self) -> dict[str, Any]:
         """`parameters` with the shape's name and any wall that is not specular
