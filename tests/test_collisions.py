@@ -119,7 +119,7 @@ def test_event_engine_stops_when_time_no_longer_advances():
     box = cd.Box(2, 2)
     particles = cd.Particles([[0.0, 0.0]], [[3.0, 0.0]], radius=0.5)
     with pytest.raises(cd.SimulationError, match="time stopped advancing"):
-        make_drift("exact").drift(particles, box, 1e17, 100.0, Tally())
+        make_drift("exact").drift(particles, box, 1e17, 100.0, Tally.for_walls(4))
 
 
 def _packed_step_gas(n: int, seed: int, boundary: str = "reflecting") -> cd.Simulation:
@@ -181,7 +181,8 @@ def test_step_mode_follows_disks_that_grow(shared, regrid):
         p.radius = 0.2
         sim.run(steps=20)
         p.radius = 0.25
-    _free_flight(p, sim.container, 0.0, Tally())  # disks now across a wall are folded back first
+    # Disks now across a wall are folded back first.
+    _free_flight(p, sim.container, 0.0, Tally.for_walls(4))
     velocity = p.velocity.copy()
     before = sim.tally.counts[0]
     sim._drift.drift(p, sim.container, sim.time, 0.0, sim.tally)  # no flight: pairs only

@@ -255,10 +255,14 @@ export function createDiskRenderer(canvas, viewport) {
   const positionBuffer = regl.buffer({ usage: "dynamic", type: "float", length: 8 });
   const styleBuffer = regl.buffer({ usage: "static", type: "float", length: 16 });
   const lineBuffer = regl.buffer({ usage: "dynamic", type: "float", length: 16 });
-  // The vessel's outline (m), as the server sends it: filled as a fan from its first corner
-  // (right for convex and star-shaped outlines) and stroked as a loop.
+  // The vessel as the server sends it (m): its outline, stroked as a loop; the triangles that
+  // fill it (any simple shape, convex or not); its partitions, stroked as separate lines.
   const vesselOutline = regl.buffer({ usage: "static", type: "float", length: 8 });
+  const vesselFill = regl.buffer({ usage: "static", type: "float", length: 8 });
+  const vesselPartitions = regl.buffer({ usage: "static", type: "float", length: 8 });
   let outlineCorners = 0;
+  let fillVertices = 0;
+  let partitionVertices = 0;
 
   const diskUniforms = {
     scale: regl.prop("scale"),
@@ -331,6 +335,14 @@ export function createDiskRenderer(canvas, viewport) {
 
   let periodic = false;
 
+  /** Fills a static buffer with points nested `depth` levels in arrays ([x, y] at depth 1,
+   * [[x, y], ...] at 2), or one dummy point; returns how many points it holds. */
+  function loadPoints(buffer, nested, depth) {
+    const flat = Array.isArray(nested) ? nested.flat(depth) : [];
+    buffer({ usage: "static", type: "float", data: flat.length ? flat : [0, 0] });
+    return flat.length / 2;
+  }
+
   /** Prepares the per-particle buffers for a new scene; nothing is drawn until a frame comes. */
   function setScene(scene) {
     const n = scene.n | 0;
@@ -339,9 +351,9 @@ export function createDiskRenderer(canvas, viewport) {
     typicalRadius = sampledMedian(radii, medianScratch);
     largestRadius = radii.reduce((most, radius) => Math.max(most, radius), 0);
     periodic = Boolean(scene.vessel?.periodic);
-    const corners = Array.isArray(scene.vessel?.outline) ? scene.vessel.outline : [];
-    outlineCorners = corners.length;
-    vesselOutline({ usage: "static", type: "float", data: corners.length ? corners.flat() : [0, 0] });
+    outlineCorners = loadPoints(vesselOutline, scene.vessel?.outline, 1);
+    fillVertices = loadPoints(vesselFill, scene.vessel?.fill, 2);
+    partitionVertices = loadPoints(vesselPartitions, scene.vessel?.partition_lines, 2);
     styles = buildStyles(radii, perParticle(scene.charge, n, 0));
     styleBuffer({ usage: "static", type: "float", data: styles });
     if (n !== capacity) reallocate(n);
@@ -395,11 +407,18 @@ export function createDiskRenderer(canvas, viewport) {
     const scale = viewport.clipScale();
     const stretch = [1, 1];
     const dpr = viewport.pixelRatio;
+    if (fillVertices > 2) {
+      const fill = { positions: vesselFill, count: fillVertices, scale, stretch };
+      drawFlat({ primitive: "triangles", ...fill, colour: [1, 1, 1, 1] });
+    }
     if (outlineCorners > 2) {
       const corners = { positions: vesselOutline, count: outlineCorners, scale, stretch };
-      drawFlat({ primitive: "triangle fan", ...corners, colour: [1, 1, 1, 1] });
       const outline = periodic ? [0.62, 0.62, 0.62, 1] : [0.2, 0.2, 0.2, 1];
       drawFlat({ primitive: "line loop", ...corners, colour: outline });
+    }
+    if (partitionVertices > 1) {
+      const walls = { positions: vesselPartitions, count: partitionVertices, scale, stretch };
+      drawFlat({ primitive: "lines", ...walls, colour: [0.2, 0.2, 0.2, 1] });
     }
     if (count > 0) {
       drawDisks({

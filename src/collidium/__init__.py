@@ -12,7 +12,7 @@ from collidium.loading import load
 from collidium.presets import presets
 from collidium.simulation import Counters, Energy, Simulation, restore
 from collidium.state import Particles
-from collidium.vessels import Box, Circle
+from collidium.vessels import Box, Circle, Partition, Polygon
 
 __all__ = [
     "Box",
@@ -22,6 +22,8 @@ __all__ = [
     "Energy",
     "InputError",
     "Particles",
+    "Partition",
+    "Polygon",
     "Simulation",
     "SimulationError",
     "load",

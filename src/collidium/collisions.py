@@ -16,7 +16,7 @@ to a `Tally`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Literal, Protocol
 
 import numpy as np
@@ -31,12 +31,8 @@ CollisionMode = Literal["exact", "step", "off"]
 COLLISION_MODES: tuple[CollisionMode, ...] = ("exact", "step", "off")
 
 
-def _zeros_int() -> IntArray:
-    return np.zeros(5, dtype=np.int64)
-
-
-def _zeros_float() -> FloatArray:
-    return np.zeros(5)
+#: Entries a tally has without walls: the pair collisions.
+_PAIR_ENTRIES = 1
 
 
 @dataclass
@@ -45,21 +41,28 @@ class Tally:
 
     Attributes
     ----------
-    counts : ndarray of int64, shape (5,)
-        Pair collisions, then hits on each wall in the order of the vessel's
-        `Vessel.wall_names` (the box's left, right, bottom, top; the circle's rim, then zeros).
-    impulse : ndarray of float64, shape (5,)
+    counts : ndarray of int64, shape (1 + W,)
+        Pair collisions, then hits on each of the vessel's W walls in the order of its
+        `Vessel.wall_names` (the box's left, right, bottom, top; the circle's rim; a polygon's
+        edges; then the partitions).
+    impulse : ndarray of float64, shape (1 + W,)
         The collision virial ``sum r_ij . dp_i`` over pair collisions (kg m^2/s; ``r_ij`` the
         centre-to-centre vector at contact, ``dp_i`` the impulse on i), then the normal momentum
         received by each wall, in the same order (kg m/s).
-    heat : ndarray of float64, shape (5,)
+    heat : ndarray of float64, shape (1 + W,)
         The energy each wall has given the disks (J; negative when it took energy), at the wall
         entries of ``counts``; nonzero only for walls that are not mirrors.
     """
 
-    counts: IntArray = field(default_factory=_zeros_int)
-    impulse: FloatArray = field(default_factory=_zeros_float)
-    heat: FloatArray = field(default_factory=_zeros_float)
+    counts: IntArray
+    impulse: FloatArray
+    heat: FloatArray
+
+    @classmethod
+    def for_walls(cls, walls: int) -> Tally:
+        """Zeros for a vessel of ``walls`` walls."""
+        size = _PAIR_ENTRIES + walls
+        return cls(np.zeros(size, dtype=np.int64), np.zeros(size), np.zeros(size))
 
 
 @dataclass(frozen=True)
@@ -73,8 +76,9 @@ class Contact:
     particle : int
         Index of a particle in it.
     partner : int
-        The other particle's index (>= 0), or ``-1 - wall`` for a wall (0 left, 1 right,
-        2 bottom, 3 top).
+        The other particle's index (>= 0), or ``-1 - contact`` for a contact with the vessel
+        (`collidium.kernels.vessels.contacts`: the box's wall 0 left, 1 right, 2 bottom, 3 top;
+        the rim; a segment).
     """
 
     time: float
@@ -208,7 +212,7 @@ class StepCollisions(_Stateless):
 
     def _make_grid(self, particles: Particles, vessel: Vessel, diameter: float) -> None:
         n = particles.n
-        width, height = (float(side) for side in vessel.size)
+        width, height = (float(side) for side in vessel.extent)
         self._layout = (n, width, height, vessel.periodic)
         self._diameter = diameter
         self._sorted = False
@@ -232,7 +236,7 @@ class StepCollisions(_Stateless):
 
     def _sort(self, particles: Particles, vessel: Vessel, fresh: bool, uniform: bool) -> None:
         """Sort the particles into cells (from last step's order when there is one)."""
-        width, height = (float(side) for side in vessel.size)
+        width, height = (float(side) for side in vessel.extent)
         if self._sorted:
             self._sorted = stepper.update_cells(
                 particles.position, particles.radius, fresh, uniform, width, height,
@@ -278,7 +282,7 @@ class StepCollisions(_Stateless):
         if particles.n == 0:
             return
         changed, uniform, largest = self._radius_summary(particles.radius)
-        width, height = (float(side) for side in vessel.size)
+        width, height = (float(side) for side in vessel.extent)
         layout = (particles.n, width, height, vessel.periodic)
         # Cells must stay at least a diameter wide; they are kept if the disks shrink.
         if layout != self._layout or 2.0 * largest > self._diameter:
@@ -327,7 +331,8 @@ class ExactCollisions:
     def state(self) -> dict[str, np.ndarray]:
         """The event queue and lazily updated positions, and the event counters."""
         out: dict[str, np.ndarray] = {
-            "events": np.array([self.events, self.rebuilds], dtype=np.int64)
+            "events": np.array([self.events, self.rebuilds], dtype=np.int64),
+            "event_codes": np.array([_EVENT_CODES]),
         }
         if self._state is not None:
             out |= {
@@ -343,7 +348,11 @@ class ExactCollisions:
         one of another layout)."""
         self.events, self.rebuilds = (int(x) for x in arrays["events"])
         queue = {k.removeprefix("queue/"): v for k, v in arrays.items() if k.startswith("queue/")}
-        usable = set(queue) == set(_QUEUE_ARRAYS) - set(_SLOT_VIEWS) and "synced_at" in arrays
+        usable = (
+            set(queue) == set(_QUEUE_ARRAYS) - set(_SLOT_VIEWS)
+            and "synced_at" in arrays
+            and int(arrays.get("event_codes", [0])[0]) == _EVENT_CODES
+        )
         self._state = _restored(queue) if usable else None
         self._synced_at = float(arrays["synced_at"][0]) if usable else 0.0
 
@@ -361,7 +370,7 @@ class ExactCollisions:
     def _rebuild(self, particles: Particles, vessel: Vessel, now: float) -> dict[str, np.ndarray]:
         n = particles.n
         diameter = 2.0 * float(particles.radius.max(initial=0.0))
-        width, height = (float(side) for side in vessel.size)
+        width, height = (float(side) for side in vessel.extent)
         ncx, ncy = event_grid_shape(width, height, diameter, n)
         shared = _shared_radius_and_mass(particles)
         columns = events.BODY_COLUMNS if shared is None else events.SHARED_BODY_COLUMNS
@@ -382,7 +391,7 @@ class ExactCollisions:
             particles.position, particles.velocity, particles.radius, particles.mass,
             s["body"], s["ident"],
         )  # fmt: skip
-        events.rebuild(now, *(s[name] for name in _QUEUE_ARRAYS))
+        events.rebuild(now, *(s[name] for name in _QUEUE_ARRAYS), vessel.segments())
         return s
 
     def drift(
@@ -412,6 +421,7 @@ class ExactCollisions:
             tally.counts, tally.impulse,
             _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
             max(1, self.sort_interval * particles.n), halt, vessel.wall_table(), tally.heat,
+            vessel.segments(),
         )  # fmt: skip
         if processed < 0:
             self._state = None  # the queue is unusable; a later drift rebuilds it
@@ -498,6 +508,11 @@ def _restored(saved: dict[str, np.ndarray]) -> dict[str, np.ndarray] | None:
         if name not in _SLOT_VIEWS:
             array[...] = saved[name]
     return arrays | {name: np.array(saved[name]) for name in ("geometry", "grid")}
+
+
+#: The numbering of the engine's event codes that saved queues use (2: walls after the cell
+#: crossings, any number of them); a queue saved with another is rebuilt, not read.
+_EVENT_CODES = 2
 
 
 #: The engine's arrays that are views of columns of ``event`` (`_engine_arrays`).

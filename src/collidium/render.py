@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.collections import EllipseCollection
+from matplotlib.collections import EllipseCollection, LineCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon, Rectangle
 
@@ -310,6 +310,8 @@ class _MovieFigure:
                 linestyle="--" if t.periodic else "-",
             )
         )
+        ax.add_collection(LineCollection(list(t.vessel.partition_lines()), colors="black",
+                                         linewidths=1.2))  # fmt: skip
         (x0, y0), (x1, y1) = t.vessel.bounds
         margin = 0.02 * max(x1 - x0, y1 - y0)
         ax.set_xlim(x0 - margin, x1 + margin)

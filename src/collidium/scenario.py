@@ -7,11 +7,19 @@ A scenario file::
     seed = 1                      # seeds every random generator in the file
 
     [vessel]
-    shape = "box"                 # "box" | "circle"
+    shape = "box"                 # "box" | "circle" | "polygon"
     width = 20.0                  # m (box)
     height = 20.0                 # m (box)
     boundary = "reflecting"       # or "periodic" (box)
     # radius = 10.0               # m (circle)
+    # vertices = [[0, 0], [20, 0], [20, 8], [8, 8], [8, 20], [0, 20]]   # m (polygon: an L)
+
+    [[vessel.partitions]]         # a straight wall inside, any number of them
+    name = "divider"
+    start = [0.0, -10.0]          # m
+    end = [0.0, 10.0]             # m
+    gap = 1.0                     # m, a hole (0: none), centred at gap_at
+    gap_at = 0.5                  # fraction of the partition's length
 
     [vessel.walls.left]           # a wall that is not a mirror, by name
     response = "thermal"          # "specular" | "inelastic" (restitution = e) | "thermal"
@@ -93,6 +101,8 @@ from collidium.vessels import (
     Box,
     Circle,
     Inelastic,
+    Partition,
+    Polygon,
     Specular,
     Thermal,
     Vessel,
@@ -181,13 +191,33 @@ class ThermalSpec(_Model):
 WallSpec = Annotated[SpecularSpec | InelasticSpec | ThermalSpec, Field(discriminator="response")]
 
 
+class PartitionSpec(_Model):
+    """A straight wall inside the vessel, with an optional hole (`collidium.vessels.Partition`)."""
+
+    name: str
+    start: Vector
+    end: Vector
+    gap: NonNegative = 0.0
+    gap_at: Annotated[float, Field(ge=0, le=1)] = 0.5
+
+    def build(self) -> Partition:
+        """The `Partition` this describes."""
+        return Partition(self.name, (self.start[0], self.start[1]), (self.end[0], self.end[1]),
+                         self.gap, self.gap_at)  # fmt: skip
+
+
 class _VesselSpec(_Model):
-    """What every vessel table has: the responses of walls that are not mirrors, by name."""
+    """What every vessel table has: the responses of walls that are not mirrors, by name, and
+    the partitions."""
 
     walls: dict[str, WallSpec] = Field(default_factory=dict)
+    partitions: list[PartitionSpec] = Field(default_factory=list)
 
     def _walls(self) -> dict[str, WallResponse]:
         return {name: spec.build() for name, spec in self.walls.items()}
+
+    def _partitions(self) -> list[Partition]:
+        return [spec.build() for spec in self.partitions]
 
 
 class BoxSpec(_VesselSpec):
@@ -200,7 +230,8 @@ class BoxSpec(_VesselSpec):
 
     def build(self) -> Box:
         """The `Box` this describes."""
-        return Box(self.width, self.height, boundary=self.boundary, walls=self._walls())
+        return Box(self.width, self.height, boundary=self.boundary, walls=self._walls(),
+                   partitions=self._partitions())  # fmt: skip
 
 
 class CircleSpec(_VesselSpec):
@@ -211,7 +242,18 @@ class CircleSpec(_VesselSpec):
 
     def build(self) -> Circle:
         """The `Circle` this describes."""
-        return Circle(self.radius, walls=self._walls())
+        return Circle(self.radius, walls=self._walls(), partitions=self._partitions())
+
+
+class PolygonSpec(_VesselSpec):
+    """A simple polygon, its corners in m in order around it (`collidium.vessels.Polygon`)."""
+
+    shape: Literal["polygon"]
+    vertices: Annotated[list[Vector], Field(min_length=3)]
+
+    def build(self) -> Polygon:
+        """The `Polygon` this describes."""
+        return Polygon(self.vertices, walls=self._walls(), partitions=self._partitions())
 
 
 def _shape_of(value: Any) -> str:
@@ -222,7 +264,9 @@ def _shape_of(value: Any) -> str:
 
 
 VesselSpec = Annotated[
-    Annotated[BoxSpec, Tag("box")] | Annotated[CircleSpec, Tag("circle")],
+    Annotated[BoxSpec, Tag("box")]
+    | Annotated[CircleSpec, Tag("circle")]
+    | Annotated[PolygonSpec, Tag("polygon")],
     Discriminator(_shape_of),
 ]
 
@@ -542,7 +586,9 @@ Group = Annotated[ExplicitGroup | RandomGroup | RackGroup, Field(discriminator="
 
 #: Model of the vessel table, by its shape, and of a wall's table, by its response (for error
 #: messages).
-_VESSEL_SPECS: dict[str, type[_Model]] = {"box": BoxSpec, "circle": CircleSpec}
+_VESSEL_SPECS: dict[str, type[_Model]] = {
+    "box": BoxSpec, "circle": CircleSpec, "polygon": PolygonSpec,
+}  # fmt: skip
 _WALL_SPECS: dict[str, type[_Model]] = {
     "specular": SpecularSpec, "inelastic": InelasticSpec, "thermal": ThermalSpec,
 }  # fmt: skip
@@ -572,7 +618,7 @@ class Scenario(_Model):
         Label and one-line description.
     seed : int
         Seed of every random draw (group order) and of the simulation's generator.
-    vessel : BoxSpec or CircleSpec
+    vessel : BoxSpec, CircleSpec or PolygonSpec
         The vessel, chosen by its ``shape``.
     run : RunSpec
         dt, default duration and collision mode.
@@ -641,8 +687,9 @@ class Scenario(_Model):
         data = self.model_dump(mode="python", exclude_none=True)
         if not data["observers"]:
             del data["observers"]
-        if not data["vessel"]["walls"]:
-            del data["vessel"]["walls"]
+        for empty in ("walls", "partitions"):
+            if not data["vessel"][empty]:
+                del data["vessel"][empty]
         return data
 
     def to_toml(self) -> str:
@@ -899,10 +946,17 @@ def dump_toml(data: Mapping[str, Any]) -> str:
 
 
 def _toml_section(path: str, table: Mapping[str, Any]) -> str:
-    """``[path]`` with the table's values, then its nested tables as ``[path.key]``."""
-    values = {k: v for k, v in table.items() if not isinstance(v, Mapping)}
+    """``[path]`` with the table's values, then its nested tables as ``[path.key]`` and its
+    lists of tables as ``[[path.key]]``."""
+    values = {k: v for k, v in table.items() if not isinstance(v, Mapping) and not _is_tables(v)}
     nested = (_toml_section(f"{path}.{k}", v) for k, v in table.items() if isinstance(v, Mapping))
-    return f"\n[{path}]\n{_toml_table(values)}" + "".join(nested)
+    listed = (
+        f"\n[[{path}.{k}]]\n{_toml_table(item)}"
+        for k, v in table.items()
+        if _is_tables(v)
+        for item in v
+    )
+    return f"\n[{path}]\n{_toml_table(values)}" + "".join(listed) + "".join(nested)
 
 
 def _is_tables(value: Any) -> bool:

@@ -155,7 +155,7 @@ class Simulation:
         self._field = ForceField(tuple(forces))
         self._drift = make_drift(collisions)
         self._integrator = make_integrator("adaptive", DEFAULT_TOLERANCE)
-        self.tally = Tally()
+        self.tally = Tally.for_walls(len(container.wall_names))
 
     @property
     def dt(self) -> float:
@@ -283,7 +283,7 @@ class Simulation:
         vessel = self.container
         index, reason = first_invalid(
             p.position, p.velocity, p.radius, vessel.shape_code,
-            *vessel.audit_limits(OUTSIDE_TOLERANCE), vessel.periodic,
+            *vessel.audit_limits(OUTSIDE_TOLERANCE), vessel.periodic, vessel.segments(),
         )  # fmt: skip
         if index < 0:
             return
@@ -466,10 +466,12 @@ def restore_with_meta(path: str | Path) -> tuple[Simulation, dict[str, Any]]:
         sim._time_origin = (float(state["time_origin"][0]), int(state["time_origin"][1]))
         sim.steps = int(state["steps"])
         sim.rng.bit_generator.state = state["rng"]
-        sim.tally.counts[...] = arrays["tally/counts"]
-        sim.tally.impulse[...] = arrays["tally/impulse"]
-        if "tally/heat" in arrays:  # absent from checkpoints made before thermal walls
-            sim.tally.heat[...] = arrays["tally/heat"]
+        # Tallies of checkpoints made before vessels had their own number of walls held five
+        # entries, the walls' first.
+        for name in ("counts", "impulse", "heat"):
+            if f"tally/{name}" in arrays:  # heat is absent from those made before thermal walls
+                tally = getattr(sim.tally, name)
+                tally[...] = arrays[f"tally/{name}"][: tally.size]
         sim._drift.load_state(
             {k.removeprefix("drift/"): v for k, v in arrays.items() if k.startswith("drift/")}
         )

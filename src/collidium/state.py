@@ -11,6 +11,7 @@ from collidium.errors import InputError
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
 
 
 def _per_particle(name: str, value: ArrayLike, n: int) -> FloatArray:

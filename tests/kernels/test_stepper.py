@@ -26,7 +26,7 @@ def test_overlapping_pairs_resolved_like_the_twin(rng):
     velocity = rng.normal(0, 3, (n, 2))
     mass = rng.uniform(0.5, 2, n)
     particles = Particles(position.copy(), velocity.copy(), mass=mass, radius=radius)
-    tally = Tally()
+    tally = Tally.for_walls(4)
     StepCollisions().drift(particles, Box(width, width), 0.0, 0.0, tally)  # no flight: pairs only
     want_velocity = velocity.copy()
     want_done, want_virial = reference.step_collisions(position, want_velocity, mass, radius)

@@ -12,6 +12,9 @@ from collidium.kernels.placement import place_disks
 from collidium.kernels.vessels import BOX, CIRCLE
 from collidium.kernels.vessels.box import DRIFT_CHUNK, drift_periodic, drift_reflecting, fold
 
+#: No segments: a vessel without partitions.
+NONE = np.empty((0, 9))
+
 
 def test_reflecting_drift_equals_twin(rng):
     n = 500
@@ -68,7 +71,8 @@ def test_audit_equals_twin(rng, shape, periodic, n):
     velocity = rng.normal(0, 1, (n, 2))
     radius = np.full(n, 0.05)
     limit = 5.0 * (1 + 1e-9)
-    assert first_invalid(position, velocity, radius, shape, limit, limit, periodic) == (-1, 0)
+    args = (shape, limit, limit, 0.0, periodic, NONE)
+    assert first_invalid(position, velocity, radius, *args) == (-1, 0)
     two_chunks = [(3 * n // 5, "position", [0.0, -5.2]), (n // 4 + 1, "velocity", [0.0, np.inf])]
     corner = [(7, "position", [3.6, 3.6])]  # inside the box, outside the circle
     cases = [[(57, "position", [4.97, 0.0])], [(n - 1, "velocity", [np.nan, 0.0])], two_chunks]
@@ -76,8 +80,8 @@ def test_audit_equals_twin(rng, shape, periodic, n):
         p, v = position.copy(), velocity.copy()
         for index, field, value in bad:
             (p if field == "position" else v)[index] = value
-        want = reference.first_invalid(p, v, radius, shape, limit, limit, periodic)
-        assert first_invalid(p, v, radius, shape, limit, limit, periodic) == want
+        want = reference.first_invalid(p, v, radius, *args)
+        assert first_invalid(p, v, radius, *args) == want
         found = min(index for index, *_ in bad)
         inside = (periodic and bad[0][0] == 57) or (shape == BOX and bad is corner)
         assert want[0] == (-1 if inside and len(bad) == 1 else found)

@@ -85,6 +85,6 @@ def test_a_vessel_comes_back_from_its_dict_and_an_unknown_shape_is_refused():
     for box in (Box(20, 10), Box(4, 6, "periodic")):
         again = vessel_from_dict(box.to_dict())
         assert isinstance(again, Box) and again.to_dict() == box.to_dict()
-    assert set(VESSELS) == {"box", "circle"}
+    assert set(VESSELS) == {"box", "circle", "polygon"}
     with pytest.raises(InputError, match=r"vessel\.shape"):
         vessel_from_dict({"shape": "torus"})

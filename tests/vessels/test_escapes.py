@@ -1,5 +1,5 @@
-"""Never an escape: every shape, a dense gas (packing 0.6) started on a hexagonal lattice with one
-disk at 1000 m/s, ten million collisions."""
+"""Never an escape: every shape (a polygon with reflex corners included), a dense gas (packing
+0.6) started on a hexagonal lattice with one disk at 1000 m/s, ten million collisions."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from collidium import Box, Circle, Particles, Simulation
+from collidium import Box, Circle, Particles, Polygon, Simulation
 from collidium.vessels import Vessel
 
 RADIUS = 0.25
@@ -28,8 +28,17 @@ def hexagonal_inside(vessel: Vessel, rng: np.random.Generator) -> np.ndarray:
     return centres[inside]
 
 
+#: A five-pointed star: five reflex corners.
+STAR = Polygon([
+    [r * math.cos(math.pi / 2 + k * math.pi / 5), r * math.sin(math.pi / 2 + k * math.pi / 5)]
+    for k, r in zip(range(10), [20.0, 9.0] * 5, strict=True)
+])  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "vessel", [Box(24.0, 24.0), Circle(13.5), STAR], ids=["box", "circle", "star"]
+)
 @pytest.mark.slow
-@pytest.mark.parametrize("vessel", [Box(24.0, 24.0), Circle(13.5)], ids=["box", "circle"])
 def test_ten_million_collisions_at_packing_0_6_with_a_disk_at_1000_m_per_s(vessel, rng):
     position = hexagonal_inside(vessel, rng)
     n = len(position)

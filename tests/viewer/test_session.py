@@ -201,3 +201,21 @@ def test_frames_carry_positions_and_on_request_velocities(gas):
     gas.momentum = True
     full = protocol.decode_frame(gas.frame(5))
     np.testing.assert_array_equal(full["velocity"], gas.sim.particles.velocity.astype("f4"))
+
+
+def test_the_scene_sends_an_l_shaped_vessel_filled_and_its_partition():
+    """The page paints the triangles the server sends (an L is not convex) and strokes the
+    partitions' pieces, the hole left open."""
+    data = {
+        "vessel": {"shape": "polygon",
+                   "vertices": [[0, 0], [10, 0], [10, 4], [4, 4], [4, 10], [0, 10]],
+                   "partitions": [{"name": "p", "start": [2, 0], "end": [2, 10], "gap": 2.0}]},
+        "particles": [{"kind": "random", "n": 10, "radius": 0.2}],
+    }  # fmt: skip
+    vessel = ViewerSession(Scenario.from_dict(data)).scene()["vessel"]
+    triangles = np.array(vessel["fill"])
+    first, second = triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]
+    areas = 0.5 * (first[:, 0] * second[:, 1] - first[:, 1] * second[:, 0])
+    assert (areas > 0).all() and areas.sum() == pytest.approx(64.0)  # none outside, all covered
+    assert vessel["partition_lines"] == [[[2.0, 0.0], [2.0, 4.0]], [[2.0, 6.0], [2.0, 10.0]]]
+    assert vessel["walls"][-1] == "p" and vessel["partitions"][0]["gap"] == 2.0

@@ -8,7 +8,7 @@ import numba
 import numpy as np
 
 from collidium.kernels.stepper import chunk_count
-from collidium.kernels.vessels import CIRCLE, box, circle
+from collidium.kernels.vessels import contacts
 
 #: Particles from which the audit runs in parallel chunks; below, starting the threads would cost
 #: more than the pass (a two-disk scene took twice as long a step).
@@ -22,7 +22,9 @@ def first_invalid(
     shape: int,
     limit_x: float,
     limit_y: float,
+    slack: float,
     periodic: bool,
+    segments: np.ndarray,
 ) -> tuple[int, int]:
     """The first particle with a non-finite position or velocity, or outside the vessel.
 
@@ -34,11 +36,14 @@ def first_invalid(
         Radii in m.
     shape : int
         The vessel's shape code (`collidium.kernels.vessels`).
-    limit_x, limit_y : float
+    limit_x, limit_y, slack : float
         The shape's limits with their round-off allowance (`Vessel.audit_limits`): the box's
-        half sides, the circle's radius twice (m).
+        half sides, the circle's radius twice (m); how much closer than its radius a disk may
+        come to a segment (m).
     periodic : bool
         Periodic: the centre must be in the primary cell. Else the whole disk must be inside.
+    segments : ndarray, shape (S, 9)
+        The vessel's segments (`collidium.kernels.vessels.segments`).
 
     Returns
     -------
@@ -46,19 +51,21 @@ def first_invalid(
         ``(index, reason)``: reason 1 for non-finite, 2 for outside; ``(-1, 0)`` if all is well.
     """
     audit = _in_chunks if position.shape[0] >= PARALLEL_FROM else _in_order
-    index, reason = audit(position, velocity, radius, shape, limit_x, limit_y, periodic)
+    index, reason = audit(
+        position, velocity, radius, shape, limit_x, limit_y, slack, periodic, segments
+    )
     return int(index), int(reason)
 
 
 @numba.njit(cache=True)
-def _in_order(position, velocity, radius, shape, limit_x, limit_y, periodic):
+def _in_order(position, velocity, radius, shape, limit_x, limit_y, slack, periodic, segments):
     """`first_invalid` in one pass, particle by particle."""
     return _first_between(0, position.shape[0], position, velocity, radius, shape, limit_x,
-                          limit_y, periodic)  # fmt: skip
+                          limit_y, slack, periodic, segments)  # fmt: skip
 
 
 @numba.njit(cache=True, parallel=True)
-def _in_chunks(position, velocity, radius, shape, limit_x, limit_y, periodic):
+def _in_chunks(position, velocity, radius, shape, limit_x, limit_y, slack, periodic, segments):
     """`first_invalid` in parallel chunks: each finds its first, the earliest chunk's wins."""
     n = position.shape[0]
     chunks = chunk_count(n)
@@ -67,7 +74,8 @@ def _in_chunks(position, velocity, radius, shape, limit_x, limit_y, periodic):
     for p in numba.prange(chunks):
         start, stop = p * n // chunks, (p + 1) * n // chunks
         first[p], reason[p] = _first_between(start, stop, position, velocity, radius, shape,
-                                             limit_x, limit_y, periodic)  # fmt: skip
+                                             limit_x, limit_y, slack, periodic,
+                                             segments)  # fmt: skip
     for p in range(chunks):
         if first[p] >= 0:
             return first[p], reason[p]
@@ -75,24 +83,23 @@ def _in_chunks(position, velocity, radius, shape, limit_x, limit_y, periodic):
 
 
 @numba.njit(cache=True, inline="always")
-def _first_between(start, stop, position, velocity, radius, shape, limit_x, limit_y, periodic):
+def _first_between(start, stop, position, velocity, radius, shape, limit_x, limit_y, slack,
+                   periodic, segments):  # fmt: skip
     """The first invalid particle among ``start`` to ``stop - 1`` and why, or ``(-1, 0)``."""
     for i in range(start, stop):
         why = _invalid(position[i, 0], position[i, 1], velocity[i, 0], velocity[i, 1],
-                       0.0 if periodic else radius[i], shape, limit_x, limit_y)  # fmt: skip
+                       0.0 if periodic else radius[i], shape, limit_x, limit_y, slack,
+                       segments)  # fmt: skip
         if why:
             return i, why
     return -1, 0
 
 
 @numba.njit(cache=True, inline="always")
-def _invalid(x, y, vx, vy, reach, shape, limit_x, limit_y) -> int:
+def _invalid(x, y, vx, vy, reach, shape, limit_x, limit_y, slack, segments) -> int:
     """1 if the position or velocity is not finite, 2 if the disk reaches past the vessel's
-    limits, else 0."""
+    walls, else 0."""
     if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(vx) and math.isfinite(vy)):
         return 1
-    if shape == CIRCLE:
-        outside = circle.reaches_outside(x, y, reach, limit_x)
-    else:
-        outside = box.reaches_outside(x, y, reach, limit_x, limit_y)
+    outside = contacts.reaches_outside(x, y, reach, shape, limit_x, limit_y, slack, segments)
     return 2 if outside else 0

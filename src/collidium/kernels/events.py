@@ -22,7 +22,7 @@ Memory layout. At 1e5 particles and more the engine waits on memory, not arithme
   ``x, y, vx, vy, stamp`` (m, m/s, s) and, when the disks differ, ``radius, mass`` (m, kg), 56
   bytes. When all disks share one radius and one mass, ``geometry`` holds them and the row is 40
   bytes (`SHARED_BODY_COLUMNS`): smaller rows mean more collisions per second at N = 1e5.
-- An event is one int32 code: the partner's slot (>= 0), a wall (`WALL_CODES`) or a cell
+- An event is one int32 code: the partner's slot (>= 0), a wall (`FIRST_WALL_CODE`) or a cell
   crossing (`CELL_CODES`); indices are int32. The caller keeps all of a slot's integers in one
   28-byte row (`SLOT_COLUMNS`), so a slot is two rows.
 - The heap's children of a node fill one cache line, and the kernels are compiled without
@@ -46,7 +46,7 @@ import numpy as np
 from collidium.kernels import wall_responses
 from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import elastic_response
-from collidium.kernels.vessels import CIRCLE, box, circle
+from collidium.kernels.vessels import BOX, contacts
 
 #: Columns of the ``body`` rows. RADIUS and MASS exist only in rows of `BODY_COLUMNS`; rows of
 #: `SHARED_BODY_COLUMNS` take them from ``geometry``.
@@ -82,15 +82,16 @@ HALT_SIZE = 4
 #: third as deep as a binary one.
 ARITY = 8
 
-#: Event codes below 0: wall w (0 left, 1 right, 2 bottom, 3 top) is ``-1 - w``; a crossing into
-#: the neighbouring cell in direction d (0 -x, 1 +x, 2 -y, 3 +y) is ``-5 - d``.
-WALL_CODES = (-1, -4)
-CELL_CODES = (-5, -8)
-NO_EVENT = -9
+#: Event codes below 0: a crossing into the neighbouring cell in direction d (0 -x, 1 +x, 2 -y,
+#: 3 +y) is ``-1 - d``; contact c with the vessel (`collidium.kernels.vessels.contacts`: the
+#: box's wall c, the rim, a segment) is ``FIRST_WALL_CODE - c``.
+CELL_CODES = (-1, -4)
+NO_EVENT = -5
+FIRST_WALL_CODE = -6
 
 #: Index of each entry of the ``tally`` array (counts) and of the ``impulse`` array (sums).
 PAIR_COLLISIONS = 0  # tally: pair collisions; impulse: pair virial sum of r_ij . dp_i (kg m^2/s)
-WALL_HITS = 1  # 4 entries: left, right, bottom, top wall (tally: hits; impulse: kg m/s received)
+WALL_HITS = 1  # one entry per wall, `Vessel.wall_names` order (tally: hits; impulse: kg m/s)
 
 #: Relative size, against the particles' speeds, of an approach too slow to be anything but
 #: round-off (see `contact_delay`).
@@ -275,7 +276,7 @@ def _heap_build(keys, items, where) -> None:
 
 
 @_engine(inline="always")
-def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid):
+def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid, segments):
     """Earliest wall contact or cell crossing of a disk at (x, y) in cell c: ``(delay in s,
     code)``. Ties go to the first found: walls before cells, x before y."""
     hw = geometry[HALF_WIDTH]
@@ -284,14 +285,12 @@ def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid):
     periodic = grid[2] != 0
     best = math.inf
     code = NO_EVENT
-    if not periodic:  # wall w has the code -1 - w
-        if geometry[SHAPE] == CIRCLE:
-            best, wall = circle.wall_delay(x, y, vx, vy, r, geometry[RIM])
-        else:
-            best, wall = box.wall_delay(x, y, vx, vy, r, hw, hh)
-        if wall >= 0:
-            code = -1 - wall
-    for d in range(2):  # cell crossings: -5 - (2 d + upper)
+    if not periodic:
+        best, contact = contacts.earliest(x, y, vx, vy, r, geometry[SHAPE], hw, hh, geometry[RIM],
+                                          segments)  # fmt: skip
+        if contact >= 0:
+            code = FIRST_WALL_CODE - contact
+    for d in range(2):  # cell crossings: -1 - (2 d + upper)
         v = vx if d == 0 else vy
         pos = x if d == 0 else y
         half = hw if d == 0 else hh
@@ -301,11 +300,11 @@ def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid):
         if v > 0.0 and (periodic or at < cells - 1):
             delay = max((-half + (at + 1) * size - pos) / v, 0.0)
             if delay < best:
-                best, code = delay, -6 - 2 * d
+                best, code = delay, -2 - 2 * d
         elif v < 0.0 and (periodic or at > 0):
             delay = max((-half + at * size - pos) / v, 0.0)
             if delay < best:
-                best, code = delay, -5 - 2 * d
+                best, code = delay, -1 - 2 * d
     return best, code
 
 
@@ -373,7 +372,8 @@ def _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry, g
 
 
 @_engine(inline="always")
-def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, count, event):
+def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, count, event,
+            segments):  # fmt: skip
     """Find slot k's next event after time ``now`` (s), store it, return its time (s).
 
     The earliest pair contact found is kept (``event[k, KEPT]``): after a cell crossing in
@@ -383,10 +383,11 @@ def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, 
     come earlier than the kept contact, and any neighbour that changed or arrived since has
     predicted against k itself.
 
-    ``geometry`` holds the box's half sides, the cell sides and any shared radius and mass
-    (`HALF_WIDTH` to `SHARED_MASS`); ``grid`` is ``[ncx, ncy, periodic]``. Ties go to the first
-    found in a fixed order (walls, cells, then the partner with the lowest ident), so the outcome
-    does not depend on the slot order.
+    ``geometry`` holds the half sides of the grid's box, the cell sides, any shared radius and
+    mass and the vessel's shape (`HALF_WIDTH` to `RIM`); ``grid`` is ``[ncx, ncy, periodic]``;
+    ``segments`` is the vessel's segment table (`collidium.kernels.vessels.segments`). Ties go
+    to the first found in a fixed order (walls, cells, then the partner with the lowest ident),
+    so the outcome does not depend on the slot order.
     """
     lag = now - body[k, STAMP]
     vx = body[k, VX]
@@ -394,7 +395,7 @@ def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, 
     x = body[k, X] + vx * lag
     y = body[k, Y] + vy * lag
     r = _radius(k, body, geometry)
-    when, code = _walls_and_cells(x, y, vx, vy, r, cell_of[k], geometry, grid)
+    when, code = _walls_and_cells(x, y, vx, vy, r, cell_of[k], geometry, grid, segments)
     when += now
     pair = -1
     if r > 0.0:
@@ -530,7 +531,7 @@ def sort_slots(body, cell_of, event, head, next_, items, where) -> None:
 
 @_engine()
 def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event, keys, items,
-            where) -> None:  # fmt: skip
+            where, segments) -> None:  # fmt: skip
     """Start a fresh queue at time ``now`` (s) from positions synchronised at ``now``.
 
     ``body``'s positions, velocities, radii and masses and ``ident`` are filled by the caller (see
@@ -553,7 +554,7 @@ def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event
     sort_slots(body, cell_of, event, head, next_, items, where)
     for k in range(n):
         keys[k] = predict(k, now, -1, body, ident, geometry, grid, cell_of, head, next_, count,
-                          event)  # fmt: skip
+                          event, segments)  # fmt: skip
     _heap_build(keys, items, where)
 
 
@@ -584,6 +585,7 @@ def run_events(
     halt: np.ndarray,
     walls: np.ndarray,
     heat: np.ndarray,
+    segments: np.ndarray,
 ) -> int:
     """Process every event up to time ``until`` (inclusive) in time order.
 
@@ -593,9 +595,9 @@ def run_events(
         End of the drift, in s (absolute simulation time).
     image : ndarray of int64, shape (N, 2)
         Periodic image counters, by particle (not slot); updated at wraps.
-    tally : ndarray of int64, shape (5,)
-        Incremented: pair collisions, then hits on the left, right, bottom, top wall.
-    impulse : ndarray of float64, shape (5,)
+    tally : ndarray of int64, shape (1 + W,)
+        Incremented: pair collisions, then hits on each wall (`Vessel.wall_names` order).
+    impulse : ndarray of float64, shape (1 + W,)
         Incremented: the collision virial ``sum r_ij . dp_i`` (kg m^2/s, ``r_ij = x_i - x_j`` at
         contact, ``dp_i`` the impulse on i), then the momentum given to each wall (kg m/s).
     acceleration : ndarray, shape (N, 2) or (0, 2)
@@ -608,14 +610,17 @@ def run_events(
         ``halt[HALT_AFTER]`` (s): a pair collision or wall hit later than this time, of a
         particle with a non-zero ``acceleration``, stops the drift before it is processed; its
         time and particles go to ``halt[HALT_TIME]``, ``halt[HALT_PARTICLE]`` and
-        ``halt[HALT_PARTNER]`` (the partner, or ``-1 - wall``); ``halt[HALT_TIME]`` is NaN if
+        ``halt[HALT_PARTNER]`` (the partner, or ``-1 - contact`` for a contact with the vessel,
+        `collidium.kernels.vessels.contacts`); ``halt[HALT_TIME]`` is NaN if
         the drift ran to ``until``. Infinity never halts. The engine's state is then part-way
         through the drift: the caller rebuilds it (`collidium.integrators` takes such a drift
         again, shorter, so that the contact falls between two substeps).
     walls : ndarray, shape (W, 3)
         The vessel's wall table (`collidium.kernels.wall_responses`): how each wall responds.
-    heat : ndarray of float64, shape (5,)
+    heat : ndarray of float64, shape (1 + W,)
         Incremented like ``impulse``'s wall entries by the energy each wall gives the disks (J).
+    segments : ndarray, shape (S, 9)
+        The vessel's segments (`collidium.kernels.vessels.segments`).
     (other arrays)
         Engine state as built by `rebuild`; updated in place.
 
@@ -662,18 +667,18 @@ def run_events(
                 count[k] += 1
                 count[j] += 1
                 t_j = predict(j, t, -1, body, ident, geometry, grid, cell_of, head, next_,
-                              count, event)  # fmt: skip
+                              count, event, segments)  # fmt: skip
                 heap_update(j, t_j, keys, items, where)
-        elif code >= WALL_CODES[1]:
-            _bounce(k, -1 - code, t, body, ident, geometry, tally, impulse, acceleration, midpoint,
-                    walls, heat)  # fmt: skip
+        elif code <= FIRST_WALL_CODE:
+            _bounce(k, FIRST_WALL_CODE - code, t, body, ident, geometry, tally, impulse,
+                    acceleration, midpoint, walls, heat, segments)  # fmt: skip
             count[k] += 1
         elif code >= CELL_CODES[1]:
-            crossed = -5 - code
+            crossed = -1 - code
             _advance(k, t, body)
             _cross_cell(k, crossed, body, ident, image, geometry, grid, cell_of, head, next_)
         t_k = predict(k, t, crossed, body, ident, geometry, grid, cell_of, head, next_, count,
-                      event)  # fmt: skip
+                      event, segments)  # fmt: skip
         heap_update(k, t_k, keys, items, where)
     return processed
 
@@ -689,8 +694,8 @@ def _halts(k, t, body, ident, count, event, acceleration, halt) -> bool:
         if count[code] != event[k, PARTNER_COUNT]:
             return False  # stale
         partner = ident[code]
-    elif code >= WALL_CODES[1]:
-        partner = code
+    elif code <= FIRST_WALL_CODE:
+        partner = -1 - (FIRST_WALL_CODE - code)
     else:
         return False  # a cell crossing
     i = ident[k]
@@ -739,49 +744,45 @@ def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
 
 
 @_engine(inline="always")
-def _bounce(k, wall, t, body, ident, geometry, tally, impulse, acceleration, midpoint, walls,
-            heat):  # fmt: skip
-    """Slot k hits wall ``wall`` at time t (s): the box's 0 left, 1 right, 2 bottom, 3 top, or
-    the circle's rim 0. The disk is first snapped to the contact point, so that round-off never
-    leaves it past the wall; then the wall responds (``walls``, the vessel's wall table)."""
+def _bounce(k, contact, t, body, ident, geometry, tally, impulse, acceleration, midpoint, walls,
+            heat, segments):  # fmt: skip
+    """Slot k meets the vessel at ``contact`` (`collidium.kernels.vessels.contacts`) at time t
+    (s). The disk is first snapped onto the contact line, so that round-off never leaves it past
+    the wall; then the wall responds (``walls``, the vessel's wall table)."""
     _advance(k, t, body)
     r = _radius(k, body, geometry)
     m = _mass(k, body, geometry)
-    circular = geometry[SHAPE] == CIRCLE
-    d, sign = 0, 1.0
-    if circular:
-        x, y = circle.contact_point(body[k, X], body[k, Y], r, geometry[RIM])
-        body[k, X] = x
-        body[k, Y] = y
-        nx, ny = circle.outward_normal(x, y)
-    else:
-        d = wall // 2
-        hw, hh = geometry[HALF_WIDTH], geometry[HALF_HEIGHT]
-        body[k, X + d] = box.contact_coordinate(wall, r, hw, hh)
-        sign = 1.0 if wall % 2 == 1 else -1.0
-        nx, ny = (sign, 0.0) if d == 0 else (0.0, sign)
+    x, y, nx, ny, wall = contacts.touch(contact, body[k, X], body[k, Y], body[k, VX],
+                                        body[k, VY], r, geometry[SHAPE], geometry[HALF_WIDTH],
+                                        geometry[HALF_HEIGHT], geometry[RIM],
+                                        segments)  # fmt: skip
+    body[k, X] = x
+    body[k, Y] = y
     if walls[wall, wall_responses.RESPONSE] != wall_responses.SPECULAR:
         vx, vy = wall_responses.hit(walls, wall, body[k, VX], body[k, VY], nx, ny, m, ident[k],
                                     tally, impulse, heat, WALL_HITS + wall)  # fmt: skip
         body[k, VX] = vx
         body[k, VY] = vy
         return
-    if circular:
+    forced = acceleration.shape[0] > 0
+    if geometry[SHAPE] == BOX and contact < contacts.SEGMENTS_FROM:
+        # A mirror of the box: the normal is an axis, so the response is exact.
+        d = contact // 2
+        sign = 1.0 if contact % 2 == 1 else -1.0
+        before = body[k, VX + d]
+        pull = acceleration[ident[k], d] if forced else 0.0
+        after = sign * _wall_response(sign * before, sign * pull, midpoint - t, forced)
+        body[k, VX + d] = after
+        impulse[WALL_HITS + wall] += m * abs(after - before)
+    else:
         outward = body[k, VX] * nx + body[k, VY] * ny
         pull = 0.0
-        if acceleration.shape[0] > 0:
+        if forced:
             pull = acceleration[ident[k], 0] * nx + acceleration[ident[k], 1] * ny
-        change = _wall_response(outward, pull, midpoint - t, acceleration.shape[0] > 0) - outward
+        change = _wall_response(outward, pull, midpoint - t, forced) - outward
         body[k, VX] += change * nx
         body[k, VY] += change * ny
         impulse[WALL_HITS + wall] += m * abs(change)
-    else:  # a mirror of the box: the normal is an axis, so the response is exact
-        before = body[k, VX + d]
-        pull = acceleration[ident[k], d] if acceleration.shape[0] > 0 else 0.0
-        after = sign * _wall_response(sign * before, sign * pull, midpoint - t,
-                                      acceleration.shape[0] > 0)  # fmt: skip
-        body[k, VX + d] = after
-        impulse[WALL_HITS + wall] += m * abs(after - before)
     tally[WALL_HITS + wall] += 1
 
 

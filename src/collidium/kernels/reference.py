@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from collidium.kernels.vessels import CIRCLE
+from collidium.kernels.vessels import BOX, CIRCLE, segments
 from collidium.state import FloatArray, IntArray
 
 
@@ -143,33 +143,48 @@ def event_drift(
     duration: float,
     periodic: bool = False,
     rim: float | None = None,
+    table: FloatArray | None = None,
+    box_walls: bool = True,
 ) -> tuple[int, int, float, FloatArray]:
     """Event-driven hard disks, all pairs (and, if periodic, all 9 images) checked at every event,
-    in a box of half sides ``half`` or, with ``rim``, in a circle of that radius (m).
+    in a box of half sides ``half`` or, with ``rim``, in a circle of that radius (m), and against
+    the segments of ``table`` (`segments`; without ``box_walls``, they are the only walls).
 
     Positions and velocities (N, 2) are updated in place (periodic positions are left unwrapped).
     Returns (pair collisions, wall hits, collision virial ``sum r_ij . dp_i``, momentum received
-    by the left, right, bottom and top wall, or by the rim).
+    by the left, right, bottom and top wall, or by the rim, then by each segment).
     """
     now = 0.0
     pairs = walls = 0
     virial = 0.0
-    wall_impulse = np.zeros(4 if rim is None else 1)
+    table = np.empty((0, segments.SEGMENT_COLUMNS)) if table is None else table
+    own = 1 if rim is not None else 4 if box_walls and not periodic else 0
+    wall_impulse = np.zeros(own + len(table))
     while True:
         t_pair, i, j = _next_contact(position, velocity, radius, 2 * half, periodic)
         if periodic:
             t_wall, k, d = math.inf, -1, -1
         elif rim is not None:
             t_wall, k, d = _next_rim(position, velocity, radius, rim)
-        else:
+        elif box_walls:
             t_wall, k, d = _next_wall(position, velocity, radius, half)
-        best = min(t_pair, t_wall)
+        else:
+            t_wall, k, d = math.inf, -1, -1
+        t_segment, s, e = _next_segment(position, velocity, radius, table)
+        best = min(t_pair, t_wall, t_segment)
         if now + best > duration:
             position += velocity * (duration - now)
             return pairs, walls, virial, wall_impulse
         position += velocity * best
         now += best
-        if t_wall < t_pair and rim is not None:
+        if t_segment < min(t_pair, t_wall):
+            normal = _nearest_on_segment(position[s], table[e]) - position[s]
+            normal /= np.linalg.norm(normal)
+            outward = float(velocity[s] @ normal)
+            wall_impulse[own + e] += 2 * mass[s] * abs(outward)
+            velocity[s] -= 2 * outward * normal
+            walls += 1
+        elif t_wall < t_pair and rim is not None:
             normal = position[k] / np.linalg.norm(position[k])
             outward = float(velocity[k] @ normal)
             wall_impulse[0] += 2 * mass[k] * abs(outward)
@@ -191,6 +206,55 @@ def event_drift(
             )
             virial += mass[i] * np.dot(sep, velocity[i] - before)
             pairs += 1
+
+
+def _nearest_on_segment(point: FloatArray, row: FloatArray) -> FloatArray:
+    """The point of a segment (a row of a segment table) nearest to ``point``, m."""
+    start = row[[segments.X0, segments.Y0]]
+    end = row[[segments.X1, segments.Y1]]
+    span = end - start
+    if not span.any():
+        return start
+    along = np.clip((point - start) @ span / (span @ span), 0.0, 1.0)
+    return start + along * span
+
+
+def segment_delay(position: FloatArray, velocity: FloatArray, radius: float, row: FloatArray
+                  ) -> float:  # fmt: skip
+    """Twin of `segments.element_delay`: when a disk first comes ``radius`` from a segment while
+    approaching it, from the signed distance to its line (or NumPy's polynomial roots of the
+    squared distance to a point), inf if never."""
+    start = row[[segments.X0, segments.Y0]]
+    end = row[[segments.X1, segments.Y1]]
+    span = end - start
+    offset = position - start
+    if not span.any():  # a point: |offset + v t|^2 = r^2
+        if offset @ velocity >= 0:
+            return math.inf
+        roots = np.roots([velocity @ velocity, 2 * offset @ velocity, offset @ offset - radius**2])
+        real = roots[np.isreal(roots)].real
+        return max(float(real.min()), 0.0) if real.size else math.inf
+    normal = np.array([-span[1], span[0]]) / np.linalg.norm(span)
+    d0, w = float(offset @ normal), float(velocity @ normal)
+    if w == 0 or d0 * w >= 0:  # parallel, or moving away from the line
+        return math.inf
+    # The signed distance d0 + w t first reaches +-r on d0's side.
+    delay = max((math.copysign(radius, d0) - d0) / w, 0.0)
+    along = (offset + velocity * delay) @ span / (span @ span)
+    return delay if 0.0 <= along <= 1.0 else math.inf
+
+
+def _next_segment(
+    position: FloatArray, velocity: FloatArray, radius: FloatArray, table: FloatArray
+) -> tuple[float, int, int]:
+    """Earliest contact with a segment: (delay, particle, segment)."""
+    best, particle, segment = math.inf, -1, -1
+    for i in range(len(position)):
+        for e in range(len(table)):
+            delay = segment_delay(position[i], velocity[i], radius[i], table[e])
+            if delay < best:
+                best, particle, segment = delay, i, e
+    return best, particle, segment
 
 
 def _next_rim(
@@ -385,22 +449,44 @@ def first_invalid(
     shape: int,
     limit_x: float,
     limit_y: float,
+    slack: float,
     periodic: bool,
+    table: FloatArray,
 ) -> tuple[int, int]:
     """Twin of `audit.first_invalid`: (index, 1) for a non-finite value, (index, 2) for a particle
     outside the vessel (a box of half sides ``limit_x, limit_y``, or a circle of radius
-    ``limit_x``), whichever index comes first; (-1, 0) if none."""
+    ``limit_x``, or outside the polygon the boundary rows of ``table`` make, or closer than its
+    radius less ``slack`` to a segment), whichever index comes first; (-1, 0) if none."""
     finite = np.asarray(np.isfinite(position).all(axis=1) & np.isfinite(velocity).all(axis=1))
     reach = 0.0 if periodic else radius
     if shape == CIRCLE:
         inside = np.hypot(position[:, 0], position[:, 1]) + reach <= limit_x
-    else:
+    elif shape == BOX:
         inside = (np.abs(position) + np.asarray(reach)[..., None] <= [limit_x, limit_y]).all(axis=1)
+    else:
+        inside = np.ones(len(position), dtype=bool)
+    edges = table[table[:, segments.BOUNDARY] == 1.0]
+    for k in np.flatnonzero(finite) if len(table) else []:
+        point = position[k]
+        gap = min(np.linalg.norm(point - _nearest_on_segment(point, row)) for row in table)
+        if gap < radius[k] - slack or (
+            gap > slack and len(edges) and not _winds_around(point, edges)
+        ):
+            inside[k] = False
     bad = np.flatnonzero(~finite | ~inside)
     if bad.size == 0:
         return -1, 0
     i = int(bad[0])
     return i, 1 if not finite[i] else 2
+
+
+def _winds_around(point: FloatArray, edges: FloatArray) -> bool:
+    """Whether the closed chain of edges winds around ``point`` (its winding number is not 0):
+    the sum of the angles the edges subtend there."""
+    start = edges[:, [segments.X0, segments.Y0]] - point
+    end = edges[:, [segments.X1, segments.Y1]] - point
+    angles = np.arctan2(start[:, 0] * end[:, 1] - start[:, 1] * end[:, 0], (start * end).sum(1))
+    return bool(abs(angles.sum()) > math.pi)
 
 
 def coulomb_tree(

@@ -10,7 +10,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from collidium.state import FloatArray, IntArray
+from collidium.errors import InputError
+from collidium.kernels.vessels import contacts
+from collidium.kernels.vessels import segments as segment_kernels
+from collidium.state import BoolArray, FloatArray, IntArray
+from collidium.vessels.partitions import Partition, distances
 from collidium.vessels.walls import WallResponse, checked_walls, response_to_dict, wall_table
 
 #: Relative round-off allowance when deciding that a disk pokes out of a vessel.
@@ -21,18 +25,31 @@ class Vessel(ABC):
     """A 2D container of disks, with named walls.
 
     A shape is one module of this package: a subclass registered in `collidium.vessels.VESSELS`
-    under its `kind`, with its fast arithmetic in a kernel file of its own. Each wall has a
-    response (`collidium.vessels.walls`), specular unless the vessel's ``walls`` say otherwise.
+    under its `kind`, with its fast arithmetic in a kernel file of its own. Any vessel may hold
+    partitions (`collidium.vessels.partitions`), walls of their own after the shape's. Each wall
+    has a response (`collidium.vessels.walls`), specular unless the vessel's ``walls`` say
+    otherwise.
     """
 
     #: Responses of the walls that are not specular, by wall name.
     walls: dict[str, WallResponse]
+    #: Straight walls inside the vessel.
+    partitions: tuple[Partition, ...]
 
-    def __init__(self, walls: dict[str, WallResponse] | None = None) -> None:
-        """Keep the wall responses (after the shape has set what names its walls) and the
-        kernels' table of them, made once: a vessel does not change."""
+    def __init__(
+        self,
+        walls: dict[str, WallResponse] | None = None,
+        partitions: tuple[Partition, ...] | list[Partition] = (),
+    ) -> None:
+        """Keep the partitions and wall responses (after the shape has set its size) and the
+        kernels' tables, made once: a vessel does not change."""
+        self.partitions = tuple(partitions)
+        self._check_partitions()
         self.walls = checked_walls(self.wall_names, walls)
         self._wall_table = wall_table(self.wall_names, self.walls)
+        own = len(self.shape_walls)
+        inner = [partition.segments(own + j) for j, partition in enumerate(self.partitions)]
+        self._segments = np.concatenate([self._shape_segments(), *inner])
 
     #: The shape's name in scenario files and checkpoints (``shape: box``).
     kind: ClassVar[str]
@@ -46,9 +63,15 @@ class Vessel(ABC):
 
     @property
     @abstractmethod
+    def shape_walls(self) -> tuple[str, ...]:
+        """The shape's own walls, in the order of its kernels; empty when it has none
+        (periodic)."""
+
+    @property
     def wall_names(self) -> tuple[str, ...]:
-        """The walls, in the order of the wall counters (`collidium.collisions.Tally`); empty
-        when the vessel has none (periodic)."""
+        """The walls, in the order of the wall counters (`collidium.collisions.Tally`): the
+        shape's, then the partitions'."""
+        return self.shape_walls + tuple(partition.name for partition in self.partitions)
 
     @property
     @abstractmethod
@@ -62,6 +85,12 @@ class Vessel(ABC):
         return high - low
 
     @property
+    def extent(self) -> FloatArray:
+        """Sides ``(width, height)`` in m of the smallest box centred on the origin that holds
+        the vessel, shape (2,): what the engines' cell grids cover."""
+        return 2.0 * np.max(np.abs(self.bounds), axis=0)
+
+    @property
     @abstractmethod
     def area(self) -> float:
         """Area enclosed, m^2."""
@@ -71,17 +100,47 @@ class Vessel(ABC):
         """Corners of the boundary, counter-clockwise, in m, shape (M, 2): what a view draws
         (a curved wall comes as a fine polygon)."""
 
-    @abstractmethod
+    def fill(self) -> FloatArray:
+        """Triangles that fill the outline, shape (T, 3, 2) in m: what a view paints (any simple
+        outline, convex or not; ear clipping)."""
+        return ear_clipped(self.outline())
+
+    def partition_lines(self) -> FloatArray:
+        """The partitions' pieces as drawn, ``[[start, end], ...]`` in m, shape (P, 2, 2)."""
+        pieces = [partition.pieces() for partition in self.partitions]
+        return np.concatenate(pieces) if pieces else np.empty((0, 2, 2))
+
+    def segments(self) -> FloatArray:
+        """The kernels' segment table (`collidium.kernels.vessels.segments`): a polygon's edges
+        and reflex corners, then the partitions' pieces and their ends."""
+        return self._segments
+
+    def _shape_segments(self) -> FloatArray:
+        """Rows of the segment table that the shape itself needs (a polygon's edges and
+        corners); none by default."""
+        return np.empty((0, segment_kernels.SEGMENT_COLUMNS))
+
     def available_area(self, radius: float) -> float:
-        """Area in m^2 that the centres of disks of ``radius`` m can reach."""
+        """Area in m^2 that the centres of disks of ``radius`` m can reach: the shape's, less
+        the partitions' (`Partition.excluded_area`)."""
+        blocked = sum(partition.excluded_area(radius) for partition in self.partitions)
+        return self._open_area(radius) - blocked
 
     @abstractmethod
+    def _open_area(self, radius: float) -> float:
+        """Area in m^2 that the centres of disks of ``radius`` m can reach in the shape."""
+
     def contact_lengths(self, radius: float) -> FloatArray:
         """Length in m of each wall's line of contact for disks of ``radius`` m: the line their
         centres are on when they touch it, by wall (`wall_names` order), shape (W,). The wall
         pressure is the normal impulse per unit time per unit of it."""
+        inner = [partition.contact_length(radius) for partition in self.partitions]
+        return np.concatenate([self._shape_contact_lengths(radius), inner])
 
     @abstractmethod
+    def _shape_contact_lengths(self, radius: float) -> FloatArray:
+        """`contact_lengths` of the shape's own walls, shape (len(shape_walls),)."""
+
     def outside(self, position: FloatArray, radius: FloatArray) -> IntArray:
         """Indices of the disks not inside the vessel.
 
@@ -95,8 +154,43 @@ class Vessel(ABC):
         Returns
         -------
         ndarray of int, shape (M,)
-            Disks that reach past a wall by more than round-off, or whose centre is not finite.
+            Disks that reach past a wall or closer to a partition than their radius by more
+            than round-off, or whose centre is not finite.
         """
+        position = np.asarray(position, dtype=float)
+        bad = self._outside_shape(position, radius) | ~np.isfinite(position).all(axis=1)
+        if len(self.partitions) and len(position):
+            table = self._segments[self._segments[:, segment_kernels.BOUNDARY] == 0.0]
+            near = distances(np.nan_to_num(position), table).min(axis=1)
+            bad |= near < radius - self._slack
+        return np.flatnonzero(bad).astype(np.int64)
+
+    @abstractmethod
+    def _outside_shape(self, position: FloatArray, radius: FloatArray) -> BoolArray:
+        """Which disks reach past the shape's walls by more than round-off, shape (N,)."""
+
+    @property
+    def _slack(self) -> float:
+        """Round-off allowance in m for contacts with segments."""
+        return OUTSIDE_TOLERANCE * float(self.extent.max())
+
+    def _check_partitions(self) -> None:
+        """Refuse partitions with the name of another wall, in a vessel without walls, or not
+        inside the vessel along their whole length."""
+        if not self.partitions:
+            return
+        if self.periodic:
+            raise InputError("vessel.partitions", "a periodic box has no walls to hold them")
+        names = list(self.shape_walls)
+        for partition in self.partitions:
+            field = f"vessel.partitions.{partition.name}"
+            if partition.name in names:
+                raise InputError(field, f"the name {partition.name!r} is already a wall's")
+            names.append(partition.name)
+            along = np.linspace(0.0, 1.0, 65)[:, None]
+            points = np.array(partition.start) + along * np.subtract(partition.end, partition.start)
+            if self._outside_shape(points, np.zeros(len(points))).any():
+                raise InputError(field, f"must lie inside the {self.describe()}")
 
     @abstractmethod
     def check_fits(self, radius: FloatArray) -> None:
@@ -115,12 +209,16 @@ class Vessel(ABC):
         """A circle's radius in m, for the kernels (NaN for shapes without one)."""
         return math.nan
 
-    @abstractmethod
-    def audit_limits(self, tolerance: float) -> tuple[float, float]:
-        """The two limits (m) of the audit's outside test (`collidium.kernels.audit`) with a
-        relative round-off allowance ``tolerance``."""
+    def audit_limits(self, tolerance: float) -> tuple[float, float, float]:
+        """The limits (m) of the audit's outside test (`collidium.kernels.audit`) with a
+        relative round-off allowance ``tolerance``: the shape's two (`_shape_limits`) and the
+        allowance for segments."""
+        return *self._shape_limits(tolerance), tolerance * float(self.extent.max())
 
     @abstractmethod
+    def _shape_limits(self, tolerance: float) -> tuple[float, float]:
+        """The shape's two limits of the audit's outside test (m), allowance included."""
+
     def free_flight(
         self,
         position: FloatArray,
@@ -137,10 +235,42 @@ class Vessel(ABC):
         the exact times they are met (or wrapping periodically), adding each wall's hits, the
         momentum it receives (kg m/s) and the energy it gives (J) to ``wall_hits``,
         ``wall_impulse`` and ``wall_heat`` (`wall_names` order); ``image`` counts periodic
-        wraps."""
+        wraps. Hit by hit here (`collidium.kernels.vessels.contacts`); a shape may do better."""
+        half_width, half_height = 0.5 * self.extent
+        contacts.drift_responding(
+            position, velocity, radius, mass, dt, self.shape_code, half_width, half_height,
+            self.rim, self._segments, self._wall_table, wall_hits, wall_impulse, wall_heat,
+        )  # fmt: skip
 
-    @abstractmethod
     def wall_gap(
+        self,
+        contact: int,
+        position: FloatArray,
+        velocity: FloatArray,
+        acceleration: FloatArray,
+        radius: float,
+    ) -> Callable[[float], tuple[float, float]]:
+        """How far a disk of ``radius`` m on the path ``x + v s + a s^2 / 2`` (shapes (2,), m,
+        m/s, m/s^2) is from touching the vessel at ``contact`` (`collidium.kernels.vessels.
+        contacts`) at time s: ``s -> (gap, d gap / ds)``, zero at contact, for Newton's method.
+        For a segment, the squared distance to it less r^2 (m^2); the shape's walls in a unit of
+        the shape's choosing (`_shape_wall_gap`)."""
+        x, v, a = (np.asarray(value, dtype=float) for value in (position, velocity, acceleration))
+        if contact < contacts.SEGMENTS_FROM:
+            return self._shape_wall_gap(contact, x, v, a, radius)
+        row = self._segments[contact - contacts.SEGMENTS_FROM]
+        k = segment_kernels
+        start, tangent = row[[k.X0, k.Y0]], row[[k.TX, k.TY]]
+
+        def gap(s: float) -> tuple[float, float]:
+            at = x + (v + 0.5 * a * s) * s
+            along = min(max(float((at - start) @ tangent), 0.0), float(row[k.LENGTH]))
+            offset = at - (start + along * tangent)
+            return float(offset @ offset) - radius * radius, float(2.0 * offset @ (v + a * s))
+
+        return gap
+
+    def _shape_wall_gap(
         self,
         wall: int,
         position: FloatArray,
@@ -148,19 +278,21 @@ class Vessel(ABC):
         acceleration: FloatArray,
         radius: float,
     ) -> Callable[[float], tuple[float, float]]:
-        """How far a disk of ``radius`` m on the path ``x + v s + a s^2 / 2`` (shapes (2,), m,
-        m/s, m/s^2) is from touching ``wall`` at time s: ``s -> (gap, d gap / ds)``, zero at
-        contact and negative inside (in a unit of the shape's choosing), for Newton's method."""
+        """`wall_gap` for the shape's own wall ``wall``; shapes with walls of their own say."""
+        raise NotImplementedError(f"a {self.kind} has no walls of its own")
 
     def wall_table(self) -> FloatArray:
         """The kernels' table of wall responses, one row per wall (`wall_names` order)."""
         return self._wall_table
 
     def to_dict(self) -> dict[str, Any]:
-        """`parameters` with the shape's name and any wall that is not specular
-        (``{"shape": kind, ..., "walls": {name: {"response": ...}}}``)."""
+        """`parameters` with the shape's name, any partition and any wall that is not
+        specular (``{"shape": kind, ..., "partitions": [...], "walls": {name: {...}}}``)."""
+        out = {"shape": self.kind, **self.parameters()}
+        if self.partitions:
+            out["partitions"] = [partition.to_dict() for partition in self.partitions]
         walls = {name: response_to_dict(response) for name, response in self.walls.items()}
-        return {"shape": self.kind, **self.parameters(), **({"walls": walls} if walls else {})}
+        return out | ({"walls": walls} if walls else {})
 
     def wrap(self, position: FloatArray) -> FloatArray:
         """Positions mapped into the primary cell of a periodic vessel; an unchanged copy
@@ -170,3 +302,40 @@ class Vessel(ABC):
     def minimum_image(self, displacement: FloatArray) -> FloatArray:
         """The shortest periodic image of displacements ``(..., 2)``; unchanged otherwise."""
         return displacement
+
+
+def ear_clipped(outline: FloatArray) -> FloatArray:
+    """Triangles, shape (M - 2, 3, 2), that fill a simple polygon whose M corners are given
+    counter-clockwise: clip a convex corner with no other corner inside its triangle, repeat."""
+    corners = np.asarray(outline, dtype=float)
+    before, after = np.roll(corners, 1, axis=0), np.roll(corners, -1, axis=0)
+    turns = (corners - before)[:, 0] * (after - corners)[:, 1] - (corners - before)[:, 1] * (
+        after - corners
+    )[:, 0]
+    if (turns > 0).all():  # convex: a fan from the first corner
+        count = len(corners)
+        return np.stack([np.repeat(corners[:1], count - 2, axis=0), corners[1:-1], corners[2:]], 1)
+    left = list(range(len(corners)))
+    triangles = []
+
+    def turn(a: FloatArray, b: FloatArray, c: FloatArray) -> float:
+        return float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+
+    while len(left) > 3:
+        for k in range(len(left)):
+            ear = [left[(k + step) % len(left)] for step in (-1, 0, 1)]
+            a, b, c = corners[ear]
+            if turn(a, b, c) <= 0.0:
+                continue  # a reflex or straight corner is no ear
+            others = (corners[p] for p in left if p not in ear)
+            if any(turn(a, b, p) >= 0 and turn(b, c, p) >= 0 and turn(c, a, p) >= 0
+                   for p in others):  # fmt: skip
+                continue
+            triangles.append((a, b, c))
+            del left[k]
+            break
+        else:  # only round-off leaves no ear: fan out what is left
+            break
+    first = corners[left[0]]
+    triangles += [(first, corners[left[k]], corners[left[k + 1]]) for k in range(1, len(left) - 1)]
+    return np.array(triangles)

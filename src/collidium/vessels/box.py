@@ -14,8 +14,9 @@ import numpy as np
 from collidium.errors import InputError
 from collidium.kernels.vessels import BOX
 from collidium.kernels.vessels import box as box_walls
-from collidium.state import FloatArray, IntArray
+from collidium.state import BoolArray, FloatArray, IntArray
 from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
+from collidium.vessels.partitions import Partition
 from collidium.vessels.walls import WallResponse
 
 Boundary = Literal["reflecting", "periodic"]
@@ -39,6 +40,8 @@ class Box(Vessel):
         ``Particles.image``; it has no walls.
     walls : dict of str to WallResponse, optional
         Responses of walls that are not mirrors, by name (``{"left": Thermal(2.0)}``).
+    partitions : sequence of Partition, optional
+        Straight walls inside (a reflecting box only).
     """
 
     kind: ClassVar[str] = "box"
@@ -50,6 +53,7 @@ class Box(Vessel):
         height: float,
         boundary: Boundary = "reflecting",
         walls: dict[str, WallResponse] | None = None,
+        partitions: tuple[Partition, ...] | list[Partition] = (),
     ) -> None:
         for name, value in (("width", width), ("height", height)):
             if not np.isfinite(value) or value <= 0:
@@ -59,7 +63,7 @@ class Box(Vessel):
         self.width = float(width)
         self.height = float(height)
         self.boundary: Boundary = boundary
-        super().__init__(walls)
+        super().__init__(walls, partitions)
 
     @property
     def periodic(self) -> bool:
@@ -67,7 +71,7 @@ class Box(Vessel):
         return self.boundary == "periodic"
 
     @property
-    def wall_names(self) -> tuple[str, ...]:
+    def shape_walls(self) -> tuple[str, ...]:
         """``("left", "right", "bottom", "top")``; none in a periodic box."""
         return () if self.periodic else WALLS
 
@@ -96,12 +100,12 @@ class Box(Vessel):
         """How much shorter each side is for the centres of disks of ``radius``: 2 r with walls."""
         return 0.0 if self.periodic else 2.0 * radius
 
-    def available_area(self, radius: float) -> float:
+    def _open_area(self, radius: float) -> float:
         """``(width - 2 r) (height - 2 r)`` in m^2 (the whole area in a periodic box)."""
         inset = self._inset(radius)
         return (self.width - inset) * (self.height - inset)
 
-    def contact_lengths(self, radius: float) -> FloatArray:
+    def _shape_contact_lengths(self, radius: float) -> FloatArray:
         """Left and right walls ``height - 2 r``, bottom and top ``width - 2 r``, in m (none in a
         periodic box)."""
         if self.periodic:
@@ -110,16 +114,15 @@ class Box(Vessel):
         side, across = self.height - inset, self.width - inset
         return np.array([side, side, across, across])
 
-    def outside(self, position: FloatArray, radius: FloatArray) -> IntArray:
-        """`Vessel.outside`: in a reflecting box, disks that reach past a wall by more than
-        round-off; in a periodic box, centres outside the primary cell ``[-L/2, L/2]``."""
+    def _outside_shape(self, position: FloatArray, radius: FloatArray) -> BoolArray:
+        """In a reflecting box, disks that reach past a wall by more than round-off; in a
+        periodic box, centres outside the primary cell ``[-L/2, L/2]``."""
         half = 0.5 * self.size
         if self.periodic:
             reach = np.abs(position) - half
         else:
             reach = np.abs(position) + radius[:, None] - half
-        bad = (reach > OUTSIDE_TOLERANCE * half).any(axis=1) | ~np.isfinite(position).all(axis=1)
-        return np.flatnonzero(bad).astype(np.int64)
+        return np.asarray((reach > OUTSIDE_TOLERANCE * half).any(axis=1))
 
     def check_fits(self, radius: FloatArray) -> None:
         """Refuse disks too large for the box (periodic: a diameter of at most half a side, so a
@@ -151,7 +154,7 @@ class Box(Vessel):
         size = self.size
         return displacement - size * np.round(displacement / size)
 
-    def audit_limits(self, tolerance: float) -> tuple[float, float]:
+    def _shape_limits(self, tolerance: float) -> tuple[float, float]:
         """The half sides with the round-off allowance, m."""
         return 0.5 * self.width * (1.0 + tolerance), 0.5 * self.height * (1.0 + tolerance)
 
@@ -167,23 +170,22 @@ class Box(Vessel):
         wall_impulse: FloatArray,
         wall_heat: FloatArray,
     ) -> None:
-        """`Vessel.free_flight`: the exact fold between mirror walls, hit by hit with other
-        responses, or the periodic wrap (`collidium.kernels.vessels.box`)."""
+        """`Vessel.free_flight`: the periodic wrap or the exact fold between mirror walls
+        (`collidium.kernels.vessels.box`); hit by hit with other responses or partitions."""
         half_width, half_height = 0.5 * self.width, 0.5 * self.height
         if self.periodic:
             box_walls.drift_periodic(position, velocity, image, self.width, self.height, dt)
-        elif self.walls:
-            box_walls.drift_responding(
-                position, velocity, radius, mass, half_width, half_height, dt, self.wall_table(),
-                wall_hits, wall_impulse, wall_heat,
-            )  # fmt: skip
+        elif self.walls or self.partitions:
+            super().free_flight(
+                position, velocity, radius, mass, image, dt, wall_hits, wall_impulse, wall_heat
+            )
         else:
             box_walls.drift_reflecting(
                 position, velocity, radius, mass, half_width, half_height, dt, wall_hits,
                 wall_impulse,
             )  # fmt: skip
 
-    def wall_gap(
+    def _shape_wall_gap(
         self,
         wall: int,
         position: FloatArray,

@@ -15,9 +15,9 @@ import numpy as np
 
 from collidium.errors import InputError
 from collidium.kernels.vessels import CIRCLE
-from collidium.kernels.vessels import circle as circle_walls
-from collidium.state import FloatArray, IntArray
+from collidium.state import BoolArray, FloatArray
 from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
+from collidium.vessels.partitions import Partition
 from collidium.vessels.walls import WallResponse
 
 #: Corners of the polygon that stands for the rim in drawings.
@@ -34,19 +34,26 @@ class Circle(Vessel):
         ``radius - r`` from the origin.
     walls : dict of str to WallResponse, optional
         The rim's response if it is not a mirror (``{"rim": Inelastic(0.9)}``).
+    partitions : sequence of Partition, optional
+        Straight walls inside.
     """
 
     kind: ClassVar[str] = "circle"
     shape_code: ClassVar[int] = CIRCLE
 
-    def __init__(self, radius: float, walls: dict[str, WallResponse] | None = None) -> None:
+    def __init__(
+        self,
+        radius: float,
+        walls: dict[str, WallResponse] | None = None,
+        partitions: tuple[Partition, ...] | list[Partition] = (),
+    ) -> None:
         if not (isinstance(radius, int | float) and math.isfinite(radius) and radius > 0):
             raise InputError("vessel.radius", f"must be a finite number > 0, got {radius!r}")
         self.radius = float(radius)
-        super().__init__(walls)
+        super().__init__(walls, partitions)
 
     @property
-    def wall_names(self) -> tuple[str, ...]:
+    def shape_walls(self) -> tuple[str, ...]:
         """``("rim",)``."""
         return ("rim",)
 
@@ -65,19 +72,18 @@ class Circle(Vessel):
         angle = np.linspace(0.0, 2.0 * math.pi, OUTLINE_CORNERS, endpoint=False)
         return self.radius * np.column_stack([np.cos(angle), np.sin(angle)])
 
-    def available_area(self, radius: float) -> float:
+    def _open_area(self, radius: float) -> float:
         """``pi (R - r)^2`` in m^2: the circle the centres of disks of radius r move in."""
         return math.pi * (self.radius - radius) ** 2
 
-    def contact_lengths(self, radius: float) -> FloatArray:
+    def _shape_contact_lengths(self, radius: float) -> FloatArray:
         """The rim's line of contact, ``2 pi (R - r)`` in m, shape (1,)."""
         return np.array([2.0 * math.pi * (self.radius - radius)])
 
-    def outside(self, position: FloatArray, radius: FloatArray) -> IntArray:
-        """`Vessel.outside`: disks whose rim passes the vessel's by more than round-off."""
+    def _outside_shape(self, position: FloatArray, radius: FloatArray) -> BoolArray:
+        """Disks whose rim passes the vessel's by more than round-off."""
         reach = np.hypot(position[:, 0], position[:, 1]) + radius
-        bad = ~(reach <= self.radius * (1.0 + OUTSIDE_TOLERANCE))  # NaN counts as outside
-        return np.flatnonzero(bad).astype(np.int64)
+        return np.asarray(reach > self.radius * (1.0 + OUTSIDE_TOLERANCE))
 
     def check_fits(self, radius: FloatArray) -> None:
         """Refuse disks whose diameter is not smaller than the vessel's radius (they would have
@@ -94,31 +100,12 @@ class Circle(Vessel):
         """The vessel's radius, m."""
         return self.radius
 
-    def audit_limits(self, tolerance: float) -> tuple[float, float]:
+    def _shape_limits(self, tolerance: float) -> tuple[float, float]:
         """The radius with the round-off allowance, twice (m)."""
         limit = self.radius * (1.0 + tolerance)
         return limit, limit
 
-    def free_flight(
-        self,
-        position: FloatArray,
-        velocity: FloatArray,
-        radius: FloatArray,
-        mass: FloatArray,
-        image: IntArray,
-        dt: float,
-        wall_hits: IntArray,
-        wall_impulse: FloatArray,
-        wall_heat: FloatArray,
-    ) -> None:
-        """`Vessel.free_flight`: straight lines, the rim responding at the exact times they meet
-        it (`collidium.kernels.vessels.circle`)."""
-        circle_walls.drift_responding(
-            position, velocity, radius, mass, self.radius, dt, self.wall_table(), wall_hits,
-            wall_impulse, wall_heat,
-        )  # fmt: skip
-
-    def wall_gap(
+    def _shape_wall_gap(
         self,
         wall: int,
         position: FloatArray,
@@ -127,7 +114,7 @@ class Circle(Vessel):
         radius: float,
     ) -> Callable[[float], tuple[float, float]]:
         """`Vessel.wall_gap`: ``|x(s)|^2 - (R - r)^2`` (m^2), negative inside."""
-        x, v, a = (np.asarray(value, dtype=float) for value in (position, velocity, acceleration))
+        x, v, a = position, velocity, acceleration  # arrays, from `Vessel.wall_gap`
         reach = self.radius - radius
 
         def gap(s: float) -> tuple[float, float]:

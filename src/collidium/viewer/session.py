@@ -278,6 +278,8 @@ class ViewerSession:
             "vessel": vessel.to_dict() | {
                 "description": vessel.describe(), "periodic": vessel.periodic,
                 "outline": vessel.outline().tolist(), "bounds": vessel.bounds.tolist(),
+                "fill": vessel.fill().tolist(),
+                "partition_lines": vessel.partition_lines().tolist(),
                 "walls": list(vessel.wall_names),
             },
             "radius": _compact(p.radius), "charge": _compact(p.charge),

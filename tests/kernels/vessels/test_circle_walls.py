@@ -11,7 +11,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from collidium.kernels import reference
-from collidium.kernels.vessels.circle import contact_point, drift_responding, wall_delay
+from collidium.kernels.vessels import CIRCLE
+from collidium.kernels.vessels.circle import contact_point, wall_delay
+from collidium.kernels.vessels.contacts import drift_responding
 
 RIM = 5.0
 
@@ -48,7 +50,9 @@ def test_flight_off_the_rim_equals_bounce_by_bounce_and_keeps_speed_and_angular_
     hits, impulse, heat = np.zeros(1, np.int64), np.zeros(1), np.zeros(1)
     x, v = position.copy(), velocity.copy()
     mirror = np.zeros((1, 3))
-    drift_responding(x, v, radius, mass, RIM, 3.0, mirror, hits, impulse, heat)
+    no_segments = np.empty((0, 9))
+    drift_responding(x, v, radius, mass, 3.0, CIRCLE, RIM, RIM, RIM, no_segments, mirror, hits,
+                     impulse, heat)  # fmt: skip
     twin_x, twin_v = position.copy(), velocity.copy()
     bounces = reference.circle_drift_reflecting(twin_x, twin_v, radius, RIM, 3.0)
     assert hits[0] == bounces > 3 * n  # 3 s at about 12 m/s, chords of about 8 m

@@ -1,6 +1,6 @@
 """The box's wall arithmetic, for every engine: the time to a wall and the contact point (exact
-engine), the exact fold of straight flight between walls (step and off modes), the wrap of a
-periodic box and the outside test (audit).
+engine), the exact fold of straight flight between mirror walls (step and off modes; other
+responses fly hit by hit in `contacts`), the wrap of a periodic box and the outside test (audit).
 
 The box is centred on the origin with half sides ``half_width, half_height`` (m); its walls are
 numbered 0 left, 1 right, 2 bottom, 3 top (wall ``w`` is on axis ``w // 2``, at the upper end when
@@ -13,8 +13,6 @@ import math
 
 import numba
 import numpy as np
-
-from collidium.kernels import wall_responses
 
 
 @numba.njit(cache=True, inline="always")
@@ -98,66 +96,6 @@ def fold(x: float, v: float, lo: float, hi: float) -> tuple[float, float, int]:
     if back_from_first:
         v = -v
     return min(max(x, lo), hi), v, bounces
-
-
-@numba.njit(cache=True)
-def drift_responding(
-    position: np.ndarray,
-    velocity: np.ndarray,
-    radius: np.ndarray,
-    mass: np.ndarray,
-    half_width: float,
-    half_height: float,
-    dt: float,
-    table: np.ndarray,
-    wall_hits: np.ndarray,
-    wall_impulse: np.ndarray,
-    wall_heat: np.ndarray,
-) -> None:
-    """Move every particle for ``dt`` in straight lines, hit by hit: at each wall met, the wall's
-    response (`collidium.kernels.wall_responses`), in index order (the tallies do not depend on
-    threads). For walls that are not all mirrors, where the fold does not apply.
-
-    Parameters
-    ----------
-    position, velocity : ndarray, shape (N, 2)
-        Updated in place (m, m/s).
-    radius, mass : ndarray, shape (N,)
-        Radii (m) and masses (kg).
-    half_width, half_height : float
-        Half sides of the box in m.
-    dt : float
-        Time step in s.
-    table : ndarray, shape (4, 3)
-        The walls' responses.
-    wall_hits, wall_impulse, wall_heat : ndarray, shape (4,)
-        Incremented per hit on each wall: hits, momentum received along the normal (kg m/s),
-        energy given to the disk (J).
-    """
-    for i in range(position.shape[0]):
-        left = dt
-        x, y = position[i, 0], position[i, 1]
-        vx, vy = velocity[i, 0], velocity[i, 1]
-        r = radius[i]
-        while True:
-            delay, wall = wall_delay(x, y, vx, vy, r, half_width, half_height)
-            if wall < 0 or delay >= left:
-                x += vx * left
-                y += vy * left
-                break
-            x += vx * delay
-            y += vy * delay
-            touching = contact_coordinate(wall, r, half_width, half_height)
-            sign = 1.0 if wall % 2 == 1 else -1.0
-            if wall < 2:
-                x, nx, ny = touching, sign, 0.0
-            else:
-                y, nx, ny = touching, 0.0, sign
-            vx, vy = wall_responses.hit(table, wall, vx, vy, nx, ny, mass[i], i, wall_hits,
-                                        wall_impulse, wall_heat, wall)  # fmt: skip
-            left -= delay
-        position[i, 0], position[i, 1] = x, y
-        velocity[i, 0], velocity[i, 1] = vx, vy
 
 
 #: Particles per chunk of the parallel drift. A chunk runs in parallel up to its first particle
