@@ -117,14 +117,20 @@ class Drift(Protocol):
         """Take back what `state` returned."""
 
 
-def make_drift(mode: CollisionMode) -> Drift:
-    """The drift object for a collision mode name."""
-    modes: dict[str, type[ExactCollisions | StepCollisions | NoCollisions]] = {
-        "exact": ExactCollisions,
-        "step": StepCollisions,
-        "off": NoCollisions,
-    }
-    return modes[mode]()
+#: Normal approach speed (m/s) below which an inelastic pair collision is elastic: the guard
+#: against inelastic collapse, where a cluster of disks would collide infinitely often in a
+#: finite time (a restitution that tends to 1 at low impact speed, as real grains show).
+ELASTIC_BELOW = 1e-6
+
+
+def make_drift(mode: CollisionMode, restitution: float = 1.0) -> Drift:
+    """The drift object for a collision mode name, with the pair collisions' normal restitution
+    (1: elastic)."""
+    if mode == "exact":
+        return ExactCollisions(restitution)
+    if mode == "step":
+        return StepCollisions(restitution)
+    return NoCollisions()
 
 
 _NO_ACCELERATION = np.empty((0, 2))
@@ -202,7 +208,8 @@ class StepCollisions(_Stateless):
     #: Bands of rows searched in parallel (at most one per row of cells).
     SEARCH_CHUNKS = 256
 
-    def __init__(self) -> None:
+    def __init__(self, restitution: float = 1.0) -> None:
+        self.restitution = restitution
         self._layout: tuple[int, float, float, bool] | None = None
         self._diameter = 0.0
         self._sorted = False  # whether the cell order of the step before is at hand
@@ -303,7 +310,8 @@ class StepCollisions(_Stateless):
             self._scratch = np.empty_like(self._pairs)
         tally.counts[0] += stepper.resolve_pairs(
             self._pairs[:count], particles.position, particles.velocity, particles.mass,
-            width, height, vessel.periodic, tally.impulse,
+            width, height, vessel.periodic, tally.impulse, self.restitution, ELASTIC_BELOW,
+            tally.heat,
         )  # fmt: skip
 
 
@@ -316,7 +324,9 @@ class ExactCollisions:
     force kick, an edit by the user), the queue is rebuilt from them.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, restitution: float = 1.0) -> None:
+        #: Normal restitution of the pair collisions (1: elastic).
+        self.restitution = restitution
         self._state: dict[str, np.ndarray] | None = None
         self._spare: dict[str, np.ndarray] | None = None  # arrays of a queue no longer valid
         self._synced_at = 0.0  # time (s) at which the particles were last written
@@ -384,7 +394,7 @@ class ExactCollisions:
             s = _engine_arrays(n, ncx * ncy, columns)
         s["geometry"] = np.array(
             [0.5 * width, 0.5 * height, width / ncx, height / ncy, *(shared or (np.nan, np.nan)),
-             vessel.shape_code, vessel.rim]
+             vessel.shape_code, vessel.rim, self.restitution, ELASTIC_BELOW]
         )  # fmt: skip
         s["grid"] = np.array([ncx, ncy, int(vessel.periodic)], dtype=np.int64)
         events.load(
@@ -510,9 +520,10 @@ def _restored(saved: dict[str, np.ndarray]) -> dict[str, np.ndarray] | None:
     return arrays | {name: np.array(saved[name]) for name in ("geometry", "grid")}
 
 
-#: The numbering of the engine's event codes that saved queues use (2: walls after the cell
-#: crossings, any number of them); a queue saved with another is rebuilt, not read.
-_EVENT_CODES = 2
+#: The layout of the engine's saved queues (2: walls after the cell crossings, any number of
+#: them; 3: the pairs' restitution in ``geometry``); a queue saved with another is rebuilt, not
+#: read.
+_EVENT_CODES = 3
 
 
 #: The engine's arrays that are views of columns of ``event`` (`_engine_arrays`).

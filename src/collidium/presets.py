@@ -115,7 +115,7 @@ def _scenario(name: str, values: dict[str, Any]) -> Scenario:
     entry = _ENTRIES[name]
     arguments = inspect.signature(entry.build).parameters
     built = entry.build(**{key: values[key] for key in arguments})
-    parts = built if isinstance(built, dict) else {"particles": built}
+    parts: dict[str, Any] = built if isinstance(built, dict) else {"particles": built}
     title = entry.description if entry.title is None else entry.title.format(**values)
     forces = []
     if "k" in entry.parameters:
@@ -129,7 +129,8 @@ def _scenario(name: str, values: dict[str, Any]) -> Scenario:
             | ({"walls": parts["walls"]} if "walls" in parts else {}),
             "run": {
                 key: values[key] for key in ("dt", "time", "collisions", "integrator", "tolerance")
-            },
+            }
+            | parts.get("run", {}),
             "forces": forces,
             "particles": parts["particles"],
             "observers": parts.get("observers", []),
@@ -370,6 +371,28 @@ def heat_flow(
         },
         "observers": [{"kind": "profile", "bins": 10, "axis": "x", "after": 20.0, "every": 10}],
     }
+
+
+@_preset(
+    "granular",
+    "5",
+    "inelastic disks (e = 0.9) in a periodic box: the gas cools as Haff's law",
+    common=(*_NEUTRAL, "boundary"),
+    title="{n} inelastic disks (e = {restitution:g}) cooling: T(t) = T0 / (1 + t / tau)^2",
+    width=60.0,
+    height=60.0,
+    boundary="periodic",
+    time=30.0,
+)
+def granular(
+    mass: float, radius: float, *, n: int = 2000, speed: float = 1.7, restitution: float = 0.9
+) -> dict[str, Any]:
+    """``n`` disks at random (velocity components uniform in ``[-speed, speed]`` m/s, so
+    kT0 = m speed^2 / 3) in a periodic 60 m x 60 m box, colliding with normal restitution
+    ``restitution``. The homogeneous gas cools as Haff's law (`collidium.theory.haff_time`,
+    about 18 s at the defaults); later, much longer, it forms clusters. The energy the collisions
+    take is ``collision_heat``."""
+    return {"particles": gas(mass, radius, n=n, speed=speed), "run": {"restitution": restitution}}
 
 
 def presets() -> list[str]:

@@ -31,6 +31,7 @@ A scenario file::
     collisions = "exact"          # "exact" | "step" | "off"
     integrator = "adaptive"       # "adaptive" (substeps as the forces need) | "fixed" (seed's)
     tolerance = 0.0007            # the adaptive integrator's accuracy (energy error ~ its square)
+    restitution = 1.0             # of the pair collisions, in (0, 1]: below 1, a granular gas
 
     [[forces]]
     type = "coulomb"
@@ -282,6 +283,7 @@ class RunSpec(_Model):
     collisions: Literal["exact", "step", "off"] = "exact"
     integrator: Literal["adaptive", "fixed"] = "adaptive"
     tolerance: Positive = DEFAULT_TOLERANCE
+    restitution: Annotated[float, Field(gt=0, le=1)] = 1.0
 
 
 class CoulombSpec(_Model):
@@ -722,6 +724,7 @@ class Scenario(_Model):
                     "collisions": sim.collisions,
                     "integrator": sim.integrator,
                     "tolerance": sim.tolerance,
+                    "restitution": sim.restitution,
                 },
                 "forces": [force.to_dict() for force in sim.forces],
                 "particles": [
@@ -786,6 +789,7 @@ class Scenario(_Model):
                 vessel, particles, forces=[force.build() for force in self.forces], dt=self.run.dt,
                 collisions=self.run.collisions, seed=self.seed, name=self.name,
                 integrator=self.run.integrator, tolerance=self.run.tolerance,
+                restitution=self.run.restitution,
             )  # fmt: skip
         except InputError as exc:
             if exc.particles:

@@ -76,7 +76,7 @@ class Simulation:
     Parameters
     ----------
     container : Vessel
-        The vessel (`collidium.vessels`: a `Box` or a `Circle`).
+        The vessel (`collidium.vessels`: a `Box`, a `Circle` or a `Polygon`).
     particles : Particles
         Initial state (the simulation keeps and updates this object).
     forces : sequence of Coulomb, optional
@@ -94,6 +94,10 @@ class Simulation:
     tolerance : float
         The adaptive integrator's accuracy parameter (> 0): the largest substep as a fraction of
         the forces' fastest time scale, weighted by energy (`collidium.integrators`).
+    restitution : float
+        Normal restitution coefficient e of the pair collisions, in (0, 1]: 1 (the default) is
+        elastic; below 1 the gas loses ``(1 - e^2)`` of each collision's normal kinetic energy
+        (`collision_heat`), a granular gas (`collidium.kernels.collision.pair_response`).
     seed : int, optional
         Seed of the simulation's random generator (`rng`).
     name : str, optional
@@ -119,16 +123,18 @@ class Simulation:
         name: str | None = None,
         integrator: IntegratorName = "adaptive",
         tolerance: float = DEFAULT_TOLERANCE,
+        restitution: float = 1.0,
     ) -> None:
         _check_setup(container, particles, forces, dt, collisions)
         _check_integrator(integrator, tolerance)
+        _check_restitution(restitution)
         if container.periodic:
             wrapped = container.wrap(particles.position)
             size = container.size
             particles.image += np.rint((particles.position - wrapped) / size).astype(np.int64)
             particles.position[...] = wrapped
         _check_placement(container, particles, collisions)
-        self._setup(container, particles, forces, dt, collisions, seed, name)
+        self._setup(container, particles, forces, dt, collisions, seed, name, restitution)
         self._integrator = make_integrator(integrator, tolerance)
 
     def _setup(
@@ -140,6 +146,7 @@ class Simulation:
         collisions: CollisionMode,
         seed: int | None,
         name: str | None,
+        restitution: float = 1.0,
     ) -> None:
         self.container = container
         self.particles = particles
@@ -153,7 +160,8 @@ class Simulation:
         self.observers: list[Observer] = []
         self._attached: list[Observer] = []  # observers already attached (by identity)
         self._field = ForceField(tuple(forces))
-        self._drift = make_drift(collisions)
+        self._restitution = float(restitution)
+        self._drift = make_drift(collisions, self._restitution)
         self._integrator = make_integrator("adaptive", DEFAULT_TOLERANCE)
         self.tally = Tally.for_walls(len(container.wall_names))
 
@@ -189,7 +197,20 @@ class Simulation:
         _check_mode(mode)
         if mode != self._collisions:
             self._collisions = mode
-            self._drift = make_drift(mode)
+            self._drift = make_drift(mode, self._restitution)
+
+    @property
+    def restitution(self) -> float:
+        """Normal restitution coefficient e of the pair collisions, in (0, 1] (1: elastic;
+        below 1, a granular gas that cools); may be changed between runs."""
+        return self._restitution
+
+    @restitution.setter
+    def restitution(self, value: float) -> None:
+        _check_restitution(value)
+        if value != self._restitution:
+            self._restitution = float(value)
+            self._drift = make_drift(self._collisions, self._restitution)
 
     @property
     def integrator(self) -> IntegratorName:
@@ -350,6 +371,11 @@ class Simulation:
         names = self.container.wall_names
         return {name: float(self.tally.heat[1 + k]) for k, name in enumerate(names)}
 
+    def collision_heat(self) -> float:
+        """Energy inelastic pair collisions have given the disks since the start, J (negative:
+        what they took; 0 when elastic)."""
+        return float(self.tally.heat[0])
+
     def escaped(self) -> int:
         """Number of particles outside the vessel (always 0 unless something is badly wrong)."""
         return int(self.container.outside(self.particles.position, self.particles.radius).size)
@@ -373,6 +399,7 @@ class Simulation:
             "total_speed": self.total_speed(),
             "collisions": {"pair": c.pair_collisions, "wall": c.wall_collisions},
             "wall_heat": self.wall_heat(),
+            "collision_heat": self.collision_heat(),
             "escaped": self.escaped(),
         }
 
@@ -401,6 +428,7 @@ class Simulation:
             "time_origin": list(self._time_origin),
             "steps": self.steps,
             "collisions": self.collisions,
+            "restitution": self.restitution,
             "integrator": self.integrator,
             "tolerance": self.tolerance,
             "seed": self.seed,
@@ -453,7 +481,7 @@ def restore_with_meta(path: str | Path) -> tuple[Simulation, dict[str, Any]]:
         # The saved state may hold contacts at round-off distance (or the step method's
         # overlaps): it is taken as saved, without the placement checks of a new simulation.
         sim._setup(container, particles, forces, state["dt"], state["collisions"], state["seed"],
-                   state["name"])  # fmt: skip
+                   state["name"], state.get("restitution", 1.0))  # fmt: skip
         # Checkpoints from before the adaptive integrator continue with the step they were made by.
         integrator, tolerance = state.get("integrator", "fixed"), state.get("tolerance")
         tolerance = DEFAULT_TOLERANCE if tolerance is None else tolerance
@@ -524,6 +552,11 @@ def _check_setup(
     _check_mode(collisions)
     container.check_fits(particles.radius)
     return container
+
+
+def _check_restitution(restitution: float) -> None:
+    if not (isinstance(restitution, int | float) and 0.0 < restitution <= 1.0):
+        raise InputError("restitution", f"must be in (0, 1], got {restitution!r}")
 
 
 def _check_forces(forces: Sequence[Coulomb], container: Vessel) -> None:

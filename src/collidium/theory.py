@@ -4,6 +4,8 @@ distribution, the ideal gas and the hard-disk equation of state. Boltzmann's con
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -73,3 +75,42 @@ def hard_disk_compressibility(packing: float) -> float:
     if not 0 <= packing < 0.69:
         raise InputError("packing", f"the fluid branch needs 0 <= eta < 0.69, got {packing}")
     return (1 + packing**2 / 8) / (1 - packing) ** 2
+
+
+def contact_value(packing: float) -> float:
+    """Pair correlation at contact ``chi`` of the hard-disk fluid, from Henderson's equation of
+    state (``Z = 1 + 2 eta chi``): ``chi = (1 - 7 eta / 16) / (1 - eta)^2``."""
+    hard_disk_compressibility(packing)  # the same fluid range
+    return (1 - 7 * packing / 16) / (1 - packing) ** 2
+
+
+def haff_time(density: float, diameter: float, kT: float, mass: float, restitution: float) -> float:
+    """Haff's cooling time ``tau`` (s) of a homogeneous granular gas of disks in 2D.
+
+    Each collision takes ``(1 - e^2) kT`` on average (the normal approach speed squared,
+    averaged over collisions, is ``4 kT / m``) and a disk collides ``2 n sigma chi
+    sqrt(pi kT / m)`` times per second (Enskog), so ``dT/dt = -(1 - e^2) n sigma chi
+    sqrt(pi / m) T^(3/2)`` and ``T(t) = T0 / (1 + t / tau)^2`` with
+    ``tau = 2 / ((1 - e^2) n sigma chi sqrt(pi T0 / m))``.
+
+    Parameters
+    ----------
+    density : float
+        Number of disks per unit area, 1/m^2.
+    diameter : float
+        Disk diameter sigma, m.
+    kT : float
+        Initial temperature T0 (kinetic energy per disk), J.
+    mass : float
+        Disk mass, kg.
+    restitution : float
+        Normal restitution coefficient e, in (0, 1).
+    """
+    packing = density * math.pi * diameter**2 / 4
+    rate = (1 - restitution**2) * density * diameter * contact_value(packing)
+    return 2.0 / (rate * math.sqrt(math.pi * kT / mass))
+
+
+def haff_temperature(time: ArrayLike, kT: float, tau: float) -> FloatArray:
+    """Haff's law ``T(t) = T0 / (1 + t / tau)^2`` (J) of a cooling granular gas."""
+    return np.asarray(kT / (1.0 + np.asarray(time, dtype=float) / tau) ** 2)

@@ -1,4 +1,5 @@
-"""Event-driven drift of hard disks: exact free flight between exact elastic collisions.
+"""Event-driven drift of hard disks: exact free flight between exact collisions (elastic, or
+inelastic with a normal restitution).
 
 Design (Rapaport; Donev, Torquato & Stillinger; Bannerman's DynamO for the memory layout):
 
@@ -45,7 +46,7 @@ import numpy as np
 
 from collidium.kernels import wall_responses
 from collidium.kernels.cells import cell_index, neighbour_cell
-from collidium.kernels.collision import elastic_response
+from collidium.kernels.collision import energy_change, pair_response
 from collidium.kernels.vessels import BOX, contacts
 
 #: Columns of the ``body`` rows. RADIUS and MASS exist only in rows of `BODY_COLUMNS`; rows of
@@ -56,9 +57,12 @@ SHARED_BODY_COLUMNS = 5  # 40 bytes: every disk has the radius and mass in ``geo
 
 #: Entries of ``geometry`` (m, and kg for SHARED_MASS): the half sides of the vessel's bounding
 #: box, the cell sides, the radius and mass of every disk when the rows have no columns for them
-#: (else NaN), the vessel's shape code (`collidium.kernels.vessels`) and, for a circle, its radius.
+#: (else NaN), the vessel's shape code (`collidium.kernels.vessels`) and, for a circle, its radius;
+#: then the pair collisions' restitution and the approach speed (m/s) below which they are
+#: elastic (`collidium.kernels.collision.pair_response`).
 HALF_WIDTH, HALF_HEIGHT, CELL_WIDTH, CELL_HEIGHT, SHARED_RADIUS, SHARED_MASS, SHAPE, RIM = range(8)
-GEOMETRY_SIZE = 8
+RESTITUTION, ELASTIC_BELOW = 8, 9
+GEOMETRY_SIZE = 10
 
 #: Columns of the ``event`` rows (int32): the next event's code, the earliest pair contact found
 #: (its partner's slot, or -1; the event itself if it comes first) and that partner's collision
@@ -663,7 +667,7 @@ def run_events(
             j = code
             if count[j] == event[k, PARTNER_COUNT]:
                 _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
-                         midpoint)  # fmt: skip
+                         midpoint, heat)  # fmt: skip
                 count[k] += 1
                 count[j] += 1
                 t_j = predict(j, t, -1, body, ident, geometry, grid, cell_of, head, next_,
@@ -719,8 +723,9 @@ def _advance(k: int, t: float, body: np.ndarray) -> None:
 
 
 @_engine(inline="always")
-def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration, midpoint):
-    """Elastic collision of slots k and j at time t (s)."""
+def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration, midpoint, heat):
+    """Collision of slots k and j at time t (s); an inelastic one books the kinetic energy it
+    takes in ``heat[PAIR_COLLISIONS]`` (J, negative)."""
     _advance(k, t, body)
     _advance(j, t, body)
     # Contact normal x_k - x_j; in contact the pair is at most half a side apart, so the
@@ -733,9 +738,11 @@ def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
     v1x, v1y, v2x, v2y = _pair_response(
         k, j, nx, ny, midpoint - t, body, ident, geometry, acceleration
     )
-    impulse[PAIR_COLLISIONS] += _mass(k, body, geometry) * (
-        nx * (v1x - body[k, VX]) + ny * (v1y - body[k, VY])
-    )
+    m1, m2 = _mass(k, body, geometry), _mass(j, body, geometry)
+    impulse[PAIR_COLLISIONS] += m1 * (nx * (v1x - body[k, VX]) + ny * (v1y - body[k, VY]))
+    if geometry[RESTITUTION] != 1.0:
+        heat[PAIR_COLLISIONS] += energy_change(m1, m2, body[k, VX], body[k, VY], body[j, VX],
+                                               body[j, VY], v1x, v1y, v2x, v2y)  # fmt: skip
     body[k, VX] = v1x
     body[k, VY] = v1y
     body[j, VX] = v2x
@@ -800,19 +807,20 @@ def _pair_response(k, j, nx, ny, lead, body, ident, geometry, acceleration):
     """
     m1 = _mass(k, body, geometry)
     m2 = _mass(j, body, geometry)
+    e, below = geometry[RESTITUTION], geometry[ELASTIC_BELOW]
     v1x, v1y = body[k, VX], body[k, VY]
     v2x, v2y = body[j, VX], body[j, VY]
     if acceleration.shape[0] > 0:
         a, b = ident[k], ident[j]
         d1x, d1y = lead * acceleration[a, 0], lead * acceleration[a, 1]
         d2x, d2y = lead * acceleration[b, 0], lead * acceleration[b, 1]
-        w1x, w1y, w2x, w2y = elastic_response(
-            m1, m2, nx, ny, v1x - d1x, v1y - d1y, v2x - d2x, v2y - d2y
+        w1x, w1y, w2x, w2y = pair_response(
+            m1, m2, nx, ny, v1x - d1x, v1y - d1y, v2x - d2x, v2y - d2y, e, below
         )
         w1x, w1y, w2x, w2y = w1x + d1x, w1y + d1y, w2x + d2x, w2y + d2y
         if (w1x - w2x) * nx + (w1y - w2y) * ny > 0.0:
             return w1x, w1y, w2x, w2y
-    return elastic_response(m1, m2, nx, ny, v1x, v1y, v2x, v2y)
+    return pair_response(m1, m2, nx, ny, v1x, v1y, v2x, v2y, e, below)
 
 
 @_engine(inline="always")

@@ -14,14 +14,23 @@ from collidium.kernels.vessels import BOX, CIRCLE, segments
 from collidium.state import FloatArray, IntArray
 
 
-def elastic_response(
-    m1: float, m2: float, x1: FloatArray, x2: FloatArray, v1: FloatArray, v2: FloatArray
+def pair_response(
+    m1: float,
+    m2: float,
+    x1: FloatArray,
+    x2: FloatArray,
+    v1: FloatArray,
+    v2: FloatArray,
+    restitution: float = 1.0,
 ) -> tuple[FloatArray, FloatArray]:
-    """Seed eq. 7 as written: velocities (2,) after an elastic collision of disks at x1, x2."""
-    n = x1 - x2
-    v1_new = v1 - 2 * m2 / (m1 + m2) * np.dot(v1 - v2, n) / np.dot(n, n) * n
-    v2_new = v2 - 2 * m1 / (m1 + m2) * np.dot(v2 - v1, -n) / np.dot(n, n) * (-n)
-    return v1_new, v2_new
+    """Seed eq. 7, in the centre-of-mass frame: velocities (2,) after a collision of disks at x1,
+    x2 whose normal relative velocity is reversed and scaled by ``restitution`` (1: elastic)."""
+    n = (x1 - x2) / np.linalg.norm(x1 - x2)
+    centre = (m1 * v1 + m2 * v2) / (m1 + m2)
+    u1, u2 = v1 - centre, v2 - centre
+    u1 = u1 - (1 + restitution) * np.dot(u1, n) * n
+    u2 = u2 - (1 + restitution) * np.dot(u2, n) * n
+    return centre + u1, centre + u2
 
 
 def fold(x: float, v: float, lo: float, hi: float) -> tuple[float, float, int]:
@@ -126,7 +135,7 @@ def step_collisions(
             if np.dot(sep, velocity[i] - velocity[j]) >= 0:
                 continue
             before = velocity[i].copy()
-            velocity[i], velocity[j] = elastic_response(
+            velocity[i], velocity[j] = pair_response(
                 mass[i], mass[j], position[i], position[j], velocity[i], velocity[j]
             )
             virial += mass[i] * np.dot(sep, velocity[i] - before)
@@ -201,7 +210,7 @@ def event_drift(
             if periodic:
                 sep -= 2 * half * np.round(sep / (2 * half))
             before = velocity[i].copy()
-            velocity[i], velocity[j] = elastic_response(
+            velocity[i], velocity[j] = pair_response(
                 mass[i], mass[j], sep, np.zeros(2), velocity[i], velocity[j]
             )
             virial += mass[i] * np.dot(sep, velocity[i] - before)

@@ -24,7 +24,7 @@ import numba
 import numpy as np
 
 from collidium.kernels.cells import grid_shape
-from collidium.kernels.collision import elastic_response
+from collidium.kernels.collision import energy_change, pair_response
 from collidium.kernels.sorting import radix_sort
 
 #: Cast to an unsigned index. Numba wraps negative indices around; with an unsigned one it need
@@ -871,8 +871,11 @@ def resolve_pairs(
     height: float,
     periodic: bool,
     impulse: np.ndarray,
+    restitution: float,
+    elastic_below: float,
+    heat: np.ndarray,
 ) -> int:
-    """Apply the elastic response to each listed pair that is approaching, in list order.
+    """Apply the collision response to each listed pair that is approaching, in list order.
 
     Parameters
     ----------
@@ -890,6 +893,11 @@ def resolve_pairs(
         Use the minimum image for the line of centres.
     impulse : ndarray of float64, shape (>=1,)
         ``impulse[0]`` is incremented by the collision virial ``sum r_ij . dp_i`` (kg m^2/s).
+    restitution, elastic_below : float
+        The pairs' restitution and the approach speed (m/s) below which they bounce elastically
+        (`collidium.kernels.collision.pair_response`).
+    heat : ndarray of float64, shape (>=1,)
+        ``heat[0]`` is incremented by the kinetic energy inelastic collisions take (J, < 0).
 
     Returns
     -------
@@ -910,10 +918,13 @@ def resolve_pairs(
         dvy = velocity[i, 1] - velocity[j, 1]
         if nx * dvx + ny * dvy >= 0.0:  # separating already: leave it (seed's directional check)
             continue
-        v1x, v1y, v2x, v2y = elastic_response(
-            mass[i], mass[j], nx, ny, velocity[i, 0], velocity[i, 1], velocity[j, 0], velocity[j, 1]
+        u1x, u1y, u2x, u2y = velocity[i, 0], velocity[i, 1], velocity[j, 0], velocity[j, 1]
+        v1x, v1y, v2x, v2y = pair_response(
+            mass[i], mass[j], nx, ny, u1x, u1y, u2x, u2y, restitution, elastic_below
         )
-        impulse[0] += mass[i] * (nx * (v1x - velocity[i, 0]) + ny * (v1y - velocity[i, 1]))
+        impulse[0] += mass[i] * (nx * (v1x - u1x) + ny * (v1y - u1y))
+        if restitution != 1.0:
+            heat[0] += energy_change(mass[i], mass[j], u1x, u1y, u2x, u2y, v1x, v1y, v2x, v2y)
         velocity[i, 0] = v1x
         velocity[i, 1] = v1y
         velocity[j, 0] = v2x

@@ -179,6 +179,7 @@ class EnergyDrift(Measurement):
 
 
 def conserved_energy(sim: Simulation) -> float:
-    """The total energy less the energy the walls have given the disks since the start, J: what
-    the dynamics conserve (the total energy itself with mirror walls)."""
-    return sim.energy().total - float(sum(sim.wall_heat().values()))
+    """The total energy less the energy the walls and inelastic collisions have given the disks
+    since the start, J: what the dynamics conserve (the total energy itself with mirror walls
+    and elastic disks)."""
+    return sim.energy().total - float(sum(sim.wall_heat().values())) - sim.collision_heat()
