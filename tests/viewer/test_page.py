@@ -220,3 +220,58 @@ def test_click_traces_a_disk_and_drag_gives_it_a_velocity(page):
     # ...and the path is a vertical line from where the disk started to past 1.5 s x 3 m/s.
     path = rows[np.abs(offset) <= 2] + box["y"]
     assert path.max() >= y - 2 and path.min() <= y - 4.5 / pixel
+
+
+#: An L with a partition that has a hole, away from the origin: the page draws what the server
+#: sends, filled only inside, whatever the shape. Its first corner is one from which a fan of
+#: triangles would paint the notch.
+L_VESSEL = {
+    "shape": "polygon",
+    "vertices": [[10, 4], [4, 4], [4, 10], [0, 10], [0, 0], [10, 0]],
+    "partitions": [{"name": "p", "start": [2, 0], "end": [2, 4], "gap": 1.0, "gap_at": 0.75}],
+}
+
+
+@pytest.fixture
+def l_page(browser):
+    from collidium.viewer.server import create_app, running
+    from collidium.viewer.session import ViewerSession
+
+    scenario = Scenario.from_dict(
+        {"vessel": L_VESSEL, "particles": [{"kind": "random", "n": 5, "radius": 0.1}]}
+    )
+    with running(create_app(lambda: ViewerSession(scenario))) as url:
+        context = browser.new_context(viewport={"width": 1280, "height": 800})
+        opened = context.new_page()
+        opened.goto(url)
+        opened.wait_for_function("window.collidiumViewer && window.collidiumViewer.framesDrawn > 2")
+        yield opened
+        context.close()
+
+
+def test_a_polygon_and_its_partition_are_drawn_from_what_the_server_sends(l_page):
+    image = pixels(l_page, "#particles")
+    height, width = image.shape[:2]
+    metre = (min(width, height) - 4) / 20.0  # the view holds [-10, 10] m: the L is off centre
+
+    def at(x0: float, x1: float, y0: float, y1: float) -> np.ndarray:
+        """Pixels of the world rectangle [x0, x1] x [y0, y1] (m)."""
+        columns = slice(round(width / 2 + x0 * metre), round(width / 2 + x1 * metre))
+        rows = slice(round(height / 2 - y1 * metre), round(height / 2 - y0 * metre))
+        return image[rows, columns]
+
+    def share(block: np.ndarray, colour: np.ndarray, within: float) -> float:
+        return float((np.abs(block - colour) <= within).all(axis=2).mean())
+
+    white = np.array([255, 255, 255])
+    assert share(at(0.3, 1.7, 4.5, 9.5), white, 5) > 0.9  # the L's upright arm
+    assert share(at(5.0, 9.5, 0.3, 3.5), white, 5) > 0.9  # its foot
+    assert share(at(4.5, 9.5, 4.5, 9.5), LETTERBOX, 3) > 0.99  # the notch is outside
+    assert share(at(-9.5, -0.5, -9.5, 9.5), LETTERBOX, 3) > 0.99  # left of the L
+    # The partition: a line (grey to black as it falls on pixels) along x = 2 m, but for its
+    # hole around y = 3 m.
+    column = round(width / 2 + 2 * metre)
+    dark = (image[:, column - 1 : column + 2] <= 160).all(axis=2).any(axis=1)
+    below = dark[round(height / 2 - 2.3 * metre) : round(height / 2 - 0.2 * metre)]
+    hole = dark[round(height / 2 - 3.3 * metre) : round(height / 2 - 2.7 * metre)]
+    assert below.mean() > 0.9 and hole.mean() < 0.2
