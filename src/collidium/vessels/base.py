@@ -43,6 +43,8 @@ class Vessel(ABC):
     ) -> None:
         """Keep the partitions and wall responses (after the shape has set its size) and the
         kernels' tables, made once: a vessel does not change."""
+        self._extent = 2.0 * np.max(np.abs(self.bounds), axis=0)
+        self._extent.flags.writeable = False
         self.partitions = tuple(partitions)
         self._check_partitions()
         self.walls = checked_walls(self.wall_names, walls)
@@ -87,8 +89,9 @@ class Vessel(ABC):
     @property
     def extent(self) -> FloatArray:
         """Sides ``(width, height)`` in m of the smallest box centred on the origin that holds
-        the vessel, shape (2,): what the engines' cell grids cover."""
-        return 2.0 * np.max(np.abs(self.bounds), axis=0)
+        the vessel, shape (2,): what the engines' cell grids cover (made once: a vessel does
+        not change)."""
+        return self._extent
 
     @property
     @abstractmethod

@@ -78,6 +78,11 @@ class Partition:
         return np.array([[a, a + (b - a) * (self.gap_at - half)],
                          [a + (b - a) * (self.gap_at + half), b]])  # fmt: skip
 
+    def piece_lengths(self) -> FloatArray:
+        """Length in m of each piece that stands, shape (P,)."""
+        pieces = self.pieces()
+        return np.asarray(np.linalg.norm(pieces[:, 1] - pieces[:, 0], axis=1))
+
     def segments(self, wall: int) -> FloatArray:
         """Its rows of the kernels' segment table, as wall ``wall``: each piece, then each
         piece's two ends (points, where disks meet a free end)."""
@@ -89,14 +94,12 @@ class Partition:
     def excluded_area(self, radius: float) -> float:
         """Area (m^2) that the centres of disks of ``radius`` m cannot reach because of it: a
         capsule around each piece (exact where the pieces stand free of other walls)."""
-        lengths = np.linalg.norm(self.pieces()[:, 1] - self.pieces()[:, 0], axis=1)
-        return float(np.sum(2.0 * radius * lengths + math.pi * radius**2))
+        return float(np.sum(2.0 * radius * self.piece_lengths() + math.pi * radius**2))
 
     def contact_length(self, radius: float) -> float:
         """Length (m) of the line the centres of touching disks are on: both sides of each
         piece and the half circles around its ends."""
-        lengths = np.linalg.norm(self.pieces()[:, 1] - self.pieces()[:, 0], axis=1)
-        return float(np.sum(2.0 * lengths + 2.0 * math.pi * radius))
+        return float(np.sum(2.0 * self.piece_lengths() + 2.0 * math.pi * radius))
 
     def to_dict(self) -> dict[str, Any]:
         """As in a scenario file's ``[[vessel.partitions]]`` table."""
