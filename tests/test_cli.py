@@ -105,6 +105,14 @@ NEGATIVE_MASS = '[[particles]]\nkind = "explicit"\nposition = [[0.0, 0.0]]\nmass
 OVERLAP = '[[particles]]\nkind = "explicit"\nposition = [[0.0, 0.0], [0.3, 0.0]]\n'
 OUTSIDE = '[[particles]]\nkind = "explicit"\nposition = [[0.0, 0.0], [12.0, 0.0]]\n'
 DT_ZERO = '[run]\ndt = 0.0\n[[particles]]\nkind = "random"\nn = 3\n'
+PISTON_OUTSIDE = (
+    '[vessel.walls.top]\nresponse = "piston"\nposition = 11.0\n'
+    '[[particles]]\nkind = "random"\nn = 3\n'
+)
+PISTON_STEP = (
+    '[vessel.walls.top]\nresponse = "piston"\nposition = 5.0\n[run]\ncollisions = "step"\n'
+    '[[particles]]\nkind = "random"\nn = 3\n'
+)
 
 
 @pytest.mark.parametrize(
@@ -118,6 +126,9 @@ DT_ZERO = '[run]\ndt = 0.0\n[[particles]]\nkind = "random"\nn = 3\n'
         (["run", "{file}"], DT_ZERO, "run.dt"),
         (["run", "{file}"], OVERLAP, "particles.0.position.1"),
         (["run", "{file}"], OUTSIDE, "particles.0.position.1"),
+        (["run", "{file}"], PISTON_OUTSIDE, "vessel.walls.top.position"),
+        (["run", "{file}"], PISTON_STEP, "run.collisions"),
+        (["run", "piston", "--set", "force=-1"], None, "force"),
         (["run", "head-on", "--dt", "0"], None, "dt"),
         (["run", "head-on", "--dt", "nan"], None, "dt"),
         (["run", "head-on", "--set", "run.dt=nan"], None, "run.dt"),

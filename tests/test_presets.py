@@ -30,6 +30,7 @@ SECTIONS = {
     "brownian": "5",
     "heat-flow": "5",
     "granular": "5",
+    "piston": "5",
 }
 
 # name -> (positions, velocities, masses, charges, radius, Coulomb (k, softening) or None)
@@ -80,7 +81,8 @@ def test_default_vessel_and_run(name):
     assert scenario.name == name
     assert scenario.run.dt == 0.01
     assert scenario.run.collisions == "exact"
-    times = {"pool-break": 60.0, "heat-flow": 60.0, "brownian": 300.0, "granular": 30.0}
+    times = {"pool-break": 60.0, "heat-flow": 60.0, "brownian": 300.0, "granular": 30.0,
+             "piston": 60.0}  # fmt: skip
     assert scenario.run.time == times.get(name, 10.0)
     if name == "circle-gas":
         assert scenario.to_dict()["vessel"] == {"shape": "circle", "radius": 11.3}
@@ -95,7 +97,9 @@ def test_default_vessel_and_run(name):
         assert scenario.run.restitution == 0.9
         return
     assert scenario.vessel.boundary == "reflecting"
-    size = {"pool-break": (40.0, 20.0), "heat-flow": (40.0, 10.0)}.get(name, (20.0, 20.0))
+    size = {"pool-break": (40.0, 20.0), "heat-flow": (40.0, 10.0), "piston": (20.0, 40.0)}.get(
+        name, (20.0, 20.0)
+    )
     assert (scenario.vessel.width, scenario.vessel.height) == size
 
 
@@ -358,3 +362,32 @@ def test_granular_resumes_bitwise_and_the_step_mode_books_its_heat(tmp_path):
     step.run(time=5.0)
     assert step.collision_heat() < -0.05 * start  # it cools in the seed's step mode too
     assert abs(step.energy().total - step.collision_heat() - start) <= 1e-12 * start
+
+
+def test_piston_preset_settles_where_its_weight_balances_the_gas():
+    """The free piston's weight over its line of contact equals the pressure the gas puts on it
+    (within 3 standard errors, block averages), and every disk stays below it."""
+    sim = preset("piston", time=1.0).build()
+    sim.run(time=40.0)  # the first swings die down
+    start, impulse = sim.tally.impulse[4], []
+    for _ in range(400):
+        sim.run(time=0.25)
+        impulse.append(sim.tally.impulse[4])
+    length = 20.0 - 2 * 0.25
+    rates = np.diff([start, *impulse]) / (0.25 * length)
+    blocks = np.array([part.mean() for part in np.array_split(rates, 20)])
+    error = blocks.std(ddof=1) / np.sqrt(20)
+    assert abs(blocks.mean() - 80.0 / length) <= 3 * error
+    assert sim.escaped() == 0
+    piston = sim.piston()
+    assert piston is not None and -20.0 < piston.position < 20.0
+
+
+def test_piston_preset_compresses_to_half_when_driven():
+    sim = preset("piston", compress=0.5).build()
+    kinetic = sim.energy().kinetic
+    sim.run(time=45.0)
+    piston = sim.piston()
+    assert piston is not None and (piston.position, piston.velocity) == (-10.0, 0.0)
+    assert piston.work == pytest.approx(sim.energy().kinetic - kinetic, rel=1e-12)
+    assert piston.work > 0  # the gas was compressed: it gained energy

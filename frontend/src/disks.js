@@ -260,6 +260,9 @@ export function createDiskRenderer(canvas, viewport) {
   const vesselOutline = regl.buffer({ usage: "static", type: "float", length: 8 });
   const vesselFill = regl.buffer({ usage: "static", type: "float", length: 8 });
   const vesselPartitions = regl.buffer({ usage: "static", type: "float", length: 8 });
+  // A piston's face, sent with every frame where it is now.
+  const pistonBuffer = regl.buffer({ usage: "dynamic", type: "float", length: 16 });
+  let pistonShown = false;
   let outlineCorners = 0;
   let fillVertices = 0;
   let partitionVertices = 0;
@@ -359,6 +362,7 @@ export function createDiskRenderer(canvas, viewport) {
     if (n !== capacity) reallocate(n);
     count = 0;
     lineVertices = 0;
+    pistonShown = false;
   }
 
   function reallocate(n) {
@@ -376,6 +380,8 @@ export function createDiskRenderer(canvas, viewport) {
     positionBuffer.subdata(frame.positions);
     shownPositions = frame.positions;
     count = frame.n;
+    pistonShown = Boolean(frame.piston);
+    if (pistonShown) pistonBuffer.subdata(frame.piston);
     lineVertices = frame.velocities ? buildMomentumLines(frame.positions, frame.velocities, frame.n) : 0;
   }
 
@@ -419,6 +425,10 @@ export function createDiskRenderer(canvas, viewport) {
     if (partitionVertices > 1) {
       const walls = { positions: vesselPartitions, count: partitionVertices, scale, stretch };
       drawFlat({ primitive: "lines", ...walls, colour: [0.2, 0.2, 0.2, 1] });
+    }
+    if (pistonShown) {
+      const face = { positions: pistonBuffer, count: 2, scale, stretch };
+      drawFlat({ primitive: "lines", ...face, colour: [0.45, 0.25, 0.1, 1] });
     }
     if (count > 0) {
       drawDisks({

@@ -16,7 +16,7 @@ to a `Tally`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal, Protocol
 
 import numpy as np
@@ -24,6 +24,7 @@ import numpy as np
 from collidium.errors import SimulationError
 from collidium.kernels import events, stepper
 from collidium.kernels.cells import event_grid_shape
+from collidium.kernels.vessels import piston as piston_kernels
 from collidium.state import FloatArray, IntArray, Particles, as_given
 from collidium.vessels import Vessel
 
@@ -37,7 +38,8 @@ _PAIR_ENTRIES = 1
 
 @dataclass
 class Tally:
-    """Running sums kept by the drift modes since a simulation started.
+    """Running sums kept by the drift modes since a simulation started, and where the
+    vessel's piston is.
 
     Attributes
     ----------
@@ -51,18 +53,32 @@ class Tally:
         received by each wall, in the same order (kg m/s).
     heat : ndarray of float64, shape (1 + W,)
         The energy each wall has given the disks (J; negative when it took energy), at the wall
-        entries of ``counts``; nonzero only for walls that are not mirrors.
+        entries of ``counts``; nonzero only for walls that are not mirrors. A piston's is the
+        work it has done on the gas.
+    piston : ndarray of float64, shape (2,) or (0,)
+        The piston's face position (m) and velocity (m/s) along its axis now; empty without
+        a piston (`collidium.vessels.walls.Piston`).
     """
 
     counts: IntArray
     impulse: FloatArray
     heat: FloatArray
+    piston: FloatArray = field(default_factory=lambda: np.empty(0))
 
     @classmethod
     def for_walls(cls, walls: int) -> Tally:
         """Zeros for a vessel of ``walls`` walls."""
         size = _PAIR_ENTRIES + walls
         return cls(np.zeros(size, dtype=np.int64), np.zeros(size), np.zeros(size))
+
+    @classmethod
+    def for_vessel(cls, vessel: Vessel) -> Tally:
+        """Zeros for the vessel's walls, and its piston where it starts."""
+        tally = cls.for_walls(len(vessel.wall_names))
+        if vessel.piston is not None:
+            piston = vessel.piston[1]
+            tally.piston = np.array([piston.position, piston.velocity], dtype=float)
+        return tally
 
 
 @dataclass(frozen=True)
@@ -358,17 +374,20 @@ class ExactCollisions:
         one of another layout)."""
         self.events, self.rebuilds = (int(x) for x in arrays["events"])
         queue = {k.removeprefix("queue/"): v for k, v in arrays.items() if k.startswith("queue/")}
+        queue.setdefault("piston", np.empty(0))  # saved before pistons: none
         usable = (
-            set(queue) == set(_QUEUE_ARRAYS) - set(_SLOT_VIEWS)
+            set(queue) == set(_QUEUE_ARRAYS) - set(_SLOT_VIEWS) | {"piston"}
             and "synced_at" in arrays
             and int(arrays.get("event_codes", [0])[0]) == _EVENT_CODES
         )
         self._state = _restored(queue) if usable else None
         self._synced_at = float(arrays["synced_at"][0]) if usable else 0.0
 
-    def _is_current(self, particles: Particles) -> bool:
+    def _is_current(self, particles: Particles, piston: FloatArray) -> bool:
         s = self._state
         if s is None or s["body"].shape[0] != particles.n:
+            return False
+        if not np.array_equal(_piston_now(s["piston"], self._synced_at), piston):
             return False
         p = particles
         synced = events.matches(
@@ -377,7 +396,9 @@ class ExactCollisions:
         )  # fmt: skip
         return bool(synced)
 
-    def _rebuild(self, particles: Particles, vessel: Vessel, now: float) -> dict[str, np.ndarray]:
+    def _rebuild(
+        self, particles: Particles, vessel: Vessel, now: float, piston: FloatArray
+    ) -> dict[str, np.ndarray]:
         n = particles.n
         diameter = 2.0 * float(particles.radius.max(initial=0.0))
         width, height = (float(side) for side in vessel.extent)
@@ -401,7 +422,12 @@ class ExactCollisions:
             particles.position, particles.velocity, particles.radius, particles.mass,
             s["body"], s["ident"],
         )  # fmt: skip
-        events.rebuild(now, *(s[name] for name in _QUEUE_ARRAYS), vessel.segments())
+        s["piston"] = (
+            vessel.piston_array(float(piston[0]), float(piston[1]), now)
+            if piston.size
+            else np.empty(0)
+        )
+        events.rebuild(now, *(s[name] for name in _QUEUE_ARRAYS), vessel.segments(), s["piston"])
         return s
 
     def drift(
@@ -417,8 +443,8 @@ class ExactCollisions:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place, or halt before the first
         contact of forced particles after ``halt_after`` (s) and return it (`Drift.drift`)."""
         _refuse_runaway(particles, vessel, dt)
-        if not self._is_current(particles):
-            self._state = self._rebuild(particles, vessel, now)
+        if not self._is_current(particles, tally.piston):
+            self._state = self._rebuild(particles, vessel, now, tally.piston)
             self.rebuilds += 1
         s = self._state
         assert s is not None
@@ -431,7 +457,7 @@ class ExactCollisions:
             tally.counts, tally.impulse,
             _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
             max(1, self.sort_interval * particles.n), halt, vessel.wall_table(), tally.heat,
-            vessel.segments(),
+            vessel.segments(), s["piston"],
         )  # fmt: skip
         if processed < 0:
             self._state = None  # the queue is unusable; a later drift rebuilds it
@@ -451,8 +477,20 @@ class ExactCollisions:
                 int(halt[events.HALT_PARTNER]),
             )
         events.synchronise(until, s["body"], s["ident"], particles.position, particles.velocity)
+        tally.piston[...] = _piston_now(s["piston"], until)
         self._synced_at = until
         return None
+
+
+def _piston_now(piston: FloatArray, t: float) -> FloatArray:
+    """The engine's piston (`collidium.kernels.vessels.piston`) as `Tally.piston`: its face's
+    position (m) and velocity (m/s) along its axis at time t (s); empty for none."""
+    if piston.size == 0:
+        return piston
+    k = piston_kernels
+    sign = 1.0 if piston[k.WALL] % 2 == 1 else -1.0
+    height, speed = k.motion(piston, t)
+    return np.array([sign * height, sign * speed])
 
 
 def _cache_aligned_rows(
@@ -517,7 +555,7 @@ def _restored(saved: dict[str, np.ndarray]) -> dict[str, np.ndarray] | None:
     for name, array in arrays.items():
         if name not in _SLOT_VIEWS:
             array[...] = saved[name]
-    return arrays | {name: np.array(saved[name]) for name in ("geometry", "grid")}
+    return arrays | {name: np.array(saved[name]) for name in ("geometry", "grid", "piston")}
 
 
 #: The layout of the engine's saved queues (2: walls after the cell crossings, any number of

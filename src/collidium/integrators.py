@@ -355,6 +355,7 @@ class _Snapshot:
         self.counts = tally.counts.copy()
         self.impulse = tally.impulse.copy()
         self.heat = tally.heat.copy()
+        self.piston = tally.piston.copy()
 
     def restore(self, particles: Particles, tally: Tally) -> None:
         """Put everything back as it was taken."""
@@ -364,3 +365,4 @@ class _Snapshot:
         tally.counts[...] = self.counts
         tally.impulse[...] = self.impulse
         tally.heat[...] = self.heat
+        tally.piston[...] = self.piston

@@ -395,6 +395,40 @@ def granular(
     return {"particles": gas(mass, radius, n=n, speed=speed), "run": {"restitution": restitution}}
 
 
+@_preset(
+    "piston",
+    "5",
+    "a gas under a free piston with a weight: it settles where the gas pressure is F/L; "
+    "or a driven slow compression, P A^2 constant",
+    title="{n} disks under a piston of {piston_mass:g} kg pushed in by {force:g} N "
+    "(driven at {compress:g} m/s when not 0)",
+    width=20.0,
+    height=40.0,
+    time=60.0,
+)
+def piston(
+    mass: float, radius: float, *, n: int = 200, speed: float = 5.0, piston_mass: float = 20.0,
+    force: float = 80.0, start: float = 0.0, compress: float = 0.0,
+) -> dict[str, Any]:  # fmt: skip
+    """``n`` disks at random (velocity components uniform in ``[-speed, speed]`` m/s) below the
+    top wall of a 20 m x 40 m box, a piston whose face starts at y = ``start`` m. Free (the
+    default), it has a mass of ``piston_mass`` kg and a weight ``force`` N pushes it down: it
+    oscillates, the gas and the piston share their energy, and it settles about the height where
+    the gas pressure on it equals ``force`` / 20 m (the hard-disk equation of state,
+    `collidium.theory.hard_disk_compressibility`). With ``compress`` > 0 it is driven down at
+    that speed (m/s) until the chamber is half as tall: slowly (far below the thermal speed),
+    the compression is adiabatic and, in 2D, ``P A^2`` stays constant (gamma = 2); run it for
+    ``time`` = (start + 20) / (2 compress) s to the end."""
+    if compress:
+        bottom = -20.0
+        stop = bottom + 0.5 * (start - bottom)
+        top = {"response": "piston", "position": start, "velocity": -compress, "driven": True,
+               "stop": stop}  # fmt: skip
+    else:
+        top = {"response": "piston", "position": start, "mass": piston_mass, "force": force}
+    return {"particles": gas(mass, radius, n=n, speed=speed), "walls": {"top": top}}
+
+
 def presets() -> list[str]:
     """Names of the presets, in the seed report's order."""
     return list(PRESETS)

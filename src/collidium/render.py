@@ -281,6 +281,7 @@ class _MovieFigure:
         self.moving: list[Artist] = [
             self.disk_artist,
             self.point_artist,
+            self.piston_artist,
             self.clock,
             *(c[0] for c in self.curves),
             *self.bars,
@@ -312,6 +313,8 @@ class _MovieFigure:
         )
         ax.add_collection(LineCollection(list(t.vessel.partition_lines()), colors="black",
                                          linewidths=1.2))  # fmt: skip
+        self.piston_at = t.log.get("piston/position")
+        (self.piston_artist,) = ax.plot([], [], color="dimgray", linewidth=4, zorder=4)
         (x0, y0), (x1, y1) = t.vessel.bounds
         margin = 0.02 * max(x1 - x0, y1 - y0)
         ax.set_xlim(x0 - margin, x1 + margin)
@@ -374,6 +377,9 @@ class _MovieFigure:
         t = self.trajectory
         self.disk_artist.set_offsets(t.position[k, self.disks])
         self.point_artist.set_offsets(t.position[k, ~self.disks])
+        if self.piston_at is not None:
+            face = t.vessel.piston_line(float(self.piston_at[k, 0]))
+            self.piston_artist.set_data(face[:, 0], face[:, 1])
         self.clock.set_text(f"t = {t.time[k]:.3f} s, {t.n} particles, {self.boundary}")
         for line, x, y in self.curves:
             line.set_data(x[: k + 1], y[: k + 1])

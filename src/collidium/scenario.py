@@ -22,8 +22,14 @@ A scenario file::
     gap_at = 0.5                  # fraction of the partition's length
 
     [vessel.walls.left]           # a wall that is not a mirror, by name
-    response = "thermal"          # "specular" | "inelastic" (restitution = e) | "thermal"
-    temperature = 2.0             # kT of the wall, J
+    response = "thermal"          # "specular" | "inelastic" (restitution = e) | "thermal" |
+    temperature = 2.0             # kT of the wall, J                        "piston" (a box's)
+
+    # [vessel.walls.top]          # a box wall that moves (exact collisions, no forces)
+    # response = "piston"
+    # position = 5.0              # m, where its face starts along its axis
+    # mass = 10.0                 # kg
+    # force = 20.0                # N, pushing it in (a weight); or driven = true, velocity = -0.1
 
     [run]
     dt = 0.01                     # s, the reporting interval
@@ -103,6 +109,7 @@ from collidium.vessels import (
     Circle,
     Inelastic,
     Partition,
+    Piston,
     Polygon,
     Specular,
     Thermal,
@@ -189,7 +196,29 @@ class ThermalSpec(_Model):
         return Thermal(self.temperature)
 
 
-WallSpec = Annotated[SpecularSpec | InelasticSpec | ThermalSpec, Field(discriminator="response")]
+class PistonSpec(_Model):
+    """A box wall that moves along its axis (`collidium.vessels.walls.Piston`): its face starts
+    at ``position`` (m, along its axis); free, with a ``mass`` (kg) and an inward ``force`` (N),
+    or ``driven`` at ``velocity`` (m/s) until ``stop`` (m)."""
+
+    response: Literal["piston"]
+    position: float
+    mass: Positive = 1.0
+    force: NonNegative = 0.0
+    velocity: float = 0.0
+    driven: bool = False
+    stop: float | None = None
+    restitution: Annotated[float, Field(gt=0.0, le=1.0)] = 1.0
+
+    def build(self) -> WallResponse:
+        """The `Piston` response."""
+        return Piston(self.position, self.mass, self.force, self.velocity, self.driven,
+                      self.stop, self.restitution)  # fmt: skip
+
+
+WallSpec = Annotated[
+    SpecularSpec | InelasticSpec | ThermalSpec | PistonSpec, Field(discriminator="response")
+]
 
 
 class PartitionSpec(_Model):
@@ -593,6 +622,7 @@ _VESSEL_SPECS: dict[str, type[_Model]] = {
 }  # fmt: skip
 _WALL_SPECS: dict[str, type[_Model]] = {
     "specular": SpecularSpec, "inelastic": InelasticSpec, "thermal": ThermalSpec,
+    "piston": PistonSpec,
 }  # fmt: skip
 
 #: Model of each table, by the discriminator value that selects it (for error messages).

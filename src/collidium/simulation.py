@@ -39,6 +39,7 @@ from collidium.kernels.cells import first_overlap, grid_shape
 from collidium.observers.base import Observer
 from collidium.state import PROPERTIES, FloatArray, Particles, as_given
 from collidium.vessels import OUTSIDE_TOLERANCE, Vessel, vessel_from_dict
+from collidium.vessels.walls import check_restitution
 
 #: Most steps one `Simulation.run` call accepts (a guard against a mistyped time or dt).
 MAX_STEPS = 1e12
@@ -55,6 +56,32 @@ class Energy:
     def total(self) -> float:
         """Kinetic plus potential energy in J."""
         return self.kinetic + self.potential
+
+
+@dataclass(frozen=True)
+class PistonState:
+    """A piston now (`Simulation.piston`).
+
+    Attributes
+    ----------
+    wall : str
+        The box wall it is.
+    position, velocity : float
+        Its face's coordinate (m) and velocity (m/s) along its axis (the y of a top or bottom
+        piston, the x of a left or right one).
+    work : float
+        Energy it has given the gas since the start, J (negative when the gas pushed it out).
+    """
+
+    wall: str
+    position: float
+    velocity: float
+    work: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain values, as in ``--json``."""
+        return {"wall": self.wall, "position": self.position, "velocity": self.velocity,
+                "work": self.work}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -127,7 +154,7 @@ class Simulation:
     ) -> None:
         _check_setup(container, particles, forces, dt, collisions)
         _check_integrator(integrator, tolerance)
-        _check_restitution(restitution)
+        check_restitution(restitution)
         if container.periodic:
             wrapped = container.wrap(particles.position)
             size = container.size
@@ -163,7 +190,7 @@ class Simulation:
         self._restitution = float(restitution)
         self._drift = make_drift(collisions, self._restitution)
         self._integrator = make_integrator("adaptive", DEFAULT_TOLERANCE)
-        self.tally = Tally.for_walls(len(container.wall_names))
+        self.tally = Tally.for_vessel(container)
 
     @property
     def dt(self) -> float:
@@ -194,7 +221,7 @@ class Simulation:
 
     @collisions.setter
     def collisions(self, mode: CollisionMode) -> None:
-        _check_mode(mode)
+        _check_mode(mode, self.container)
         if mode != self._collisions:
             self._collisions = mode
             self._drift = make_drift(mode, self._restitution)
@@ -207,7 +234,7 @@ class Simulation:
 
     @restitution.setter
     def restitution(self, value: float) -> None:
-        _check_restitution(value)
+        check_restitution(value)
         if value != self._restitution:
             self._restitution = float(value)
             self._drift = make_drift(self._collisions, self._restitution)
@@ -306,13 +333,15 @@ class Simulation:
             p.position, p.velocity, p.radius, vessel.shape_code,
             *vessel.audit_limits(OUTSIDE_TOLERANCE), vessel.periodic, vessel.segments(),
         )  # fmt: skip
-        if index < 0:
+        if index < 0 and self.tally.piston.size and self.escaped():
+            reason = 2
+        elif index < 0:
             return
         what = "a non-finite position or velocity" if reason == 1 else "left the vessel"
         if reason == 1:
             bad = np.flatnonzero(~np.isfinite(p.position).all(1) | ~np.isfinite(p.velocity).all(1))
         else:
-            bad = vessel.outside(p.position, p.radius)
+            bad = vessel.outside(p.position, p.radius, *self.tally.piston[:1])
         listed = ", ".join(str(int(i)) for i in bad[:10]) + (" ..." if bad.size > 10 else "")
         raise SimulationError(
             f"step {self.steps} (t = {self.time:.6g} s): particle(s) {listed} {what}"
@@ -378,7 +407,19 @@ class Simulation:
 
     def escaped(self) -> int:
         """Number of particles outside the vessel (always 0 unless something is badly wrong)."""
-        return int(self.container.outside(self.particles.position, self.particles.radius).size)
+        p = self.particles
+        return int(self.container.outside(p.position, p.radius, *self.tally.piston[:1]).size)
+
+    def piston(self) -> PistonState | None:
+        """Where the vessel's piston is, how fast it moves and the work it has done on the gas;
+        None without a piston (`collidium.vessels.walls.Piston`)."""
+        if self.container.piston is None:
+            return None
+        wall = self.container.piston[0]
+        position, velocity = (float(x) for x in self.tally.piston)
+        return PistonState(
+            self.container.wall_names[wall], position, velocity, float(self.tally.heat[1 + wall])
+        )
 
     def unwrapped_position(self) -> FloatArray:
         """Positions (N, 2) in m with periodic wrapping undone (equal to position otherwise)."""
@@ -388,7 +429,7 @@ class Simulation:
         """Plain numbers describing the current state (used by the CLI)."""
         e = self.energy()
         c = self.counters
-        return {
+        out = {
             "scenario": self.name,
             "n": self.particles.n,
             "time": self.time,
@@ -402,6 +443,10 @@ class Simulation:
             "collision_heat": self.collision_heat(),
             "escaped": self.escaped(),
         }
+        piston = self.piston()
+        if piston is not None:
+            out["piston"] = piston.to_dict()
+        return out
 
     def save(self, path: str | Path, **meta: Any) -> None:
         """Write a checkpoint from which `restore` continues bit for bit.
@@ -418,7 +463,7 @@ class Simulation:
         arrays = {
             "position": p.position, "velocity": p.velocity, "image": p.image,
             "tally/counts": self.tally.counts, "tally/impulse": self.tally.impulse,
-            "tally/heat": self.tally.heat,
+            "tally/heat": self.tally.heat, "tally/piston": self.tally.piston,
         } | properties | drift | integrator  # fmt: skip
         state = {
             "name": self.name,
@@ -496,7 +541,7 @@ def restore_with_meta(path: str | Path) -> tuple[Simulation, dict[str, Any]]:
         sim.rng.bit_generator.state = state["rng"]
         # Tallies of checkpoints made before vessels had their own number of walls held five
         # entries, the walls' first.
-        for name in ("counts", "impulse", "heat"):
+        for name in ("counts", "impulse", "heat", "piston"):
             if f"tally/{name}" in arrays:  # heat is absent from those made before thermal walls
                 tally = getattr(sim.tally, name)
                 tally[...] = arrays[f"tally/{name}"][: tally.size]
@@ -549,17 +594,14 @@ def _check_setup(
         raise InputError("particles", f"must be Particles, got {type(particles).__name__}")
     _check_forces(forces, container)
     _check_dt(dt)
-    _check_mode(collisions)
+    _check_mode(collisions, container)
     container.check_fits(particles.radius)
     return container
 
 
-def _check_restitution(restitution: float) -> None:
-    if not (isinstance(restitution, int | float) and 0.0 < restitution <= 1.0):
-        raise InputError("restitution", f"must be in (0, 1], got {restitution!r}")
-
-
 def _check_forces(forces: Sequence[Coulomb], container: Vessel) -> None:
+    if forces and container.piston is not None:
+        raise InputError("forces", "a vessel with a piston holds a gas without forces")
     for k, force in enumerate(forces):
         if not isinstance(force, Coulomb):
             raise InputError(f"forces.{k}", f"unknown force {type(force).__name__}")
@@ -578,9 +620,11 @@ def _check_integrator(integrator: str, tolerance: float) -> None:
         raise InputError("tolerance", f"must be a finite number > 0, got {tolerance!r}")
 
 
-def _check_mode(collisions: str) -> None:
+def _check_mode(collisions: str, container: Vessel) -> None:
     if collisions not in COLLISION_MODES:
         raise InputError("collisions", f"must be one of {COLLISION_MODES}, got {collisions!r}")
+    if collisions != "exact" and container.piston is not None:
+        raise InputError("collisions", "a piston moves in the exact engine only: use 'exact'")
 
 
 def _check_dt(dt: float) -> None:

@@ -191,3 +191,16 @@ def test_the_vessel_is_logged_and_read_back_and_files_without_it_get_their_box(t
         frame.log = {}
         out.append(frame)
     assert read_trajectory(plain).vessel.to_dict() == cd.Box(30.0, 20.0, "periodic").to_dict()
+
+
+def test_the_piston_is_logged_and_drawn_where_it_was(tmp_path):
+    sim, path = record(tmp_path, "piston", every=50, steps=200)
+    trajectory = read_trajectory(path)
+    assert trajectory.vessel.to_dict() == sim.container.to_dict()
+    position = trajectory.log["piston/position"][:, 0]
+    assert position.shape == (5,) and np.ptp(position) > 0  # the first frame, then 4; it moved
+    piston = sim.piston()
+    assert piston is not None
+    assert (position[-1], trajectory.log["piston/work"][-1, 0]) == (piston.position, piston.work)
+    line = trajectory.vessel.piston_line(float(position[-1]))
+    np.testing.assert_array_equal(line, [[-10.0, position[-1]], [10.0, position[-1]]])

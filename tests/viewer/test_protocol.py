@@ -77,6 +77,19 @@ def test_frames_round_trip_in_float32(rng):
     assert len(protocol.encode_frame(1, 0.0, 1, position, velocity)) == 32 + 7 * 16
 
 
+def test_a_frame_carries_the_piston_where_it_is(rng):
+    position = rng.uniform(-10, 10, (3, 2))
+    face = np.array([[-10.0, 2.5], [10.0, 2.5]])
+    data = protocol.encode_frame(2, 1.0, 1, position, None, face)
+    frame = protocol.decode_frame(data)
+    assert frame["flags"] == protocol.FLAG_PISTON and frame["velocity"] is None
+    np.testing.assert_array_equal(frame["piston"], face)
+    np.testing.assert_array_equal(frame["position"], position.astype(np.float32))
+    assert len(data) == 32 + 3 * 8 + 16
+    with pytest.raises(InputError, match="bytes where"):
+        protocol.decode_frame(data[:-4])
+
+
 def test_a_truncated_frame_is_refused(rng):
     data = protocol.encode_frame(1, 0.0, 1, rng.uniform(size=(4, 2)))
     with pytest.raises(InputError, match="bytes where"):

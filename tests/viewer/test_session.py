@@ -68,6 +68,21 @@ def test_collisions_switch_off_and_back_to_the_scenario_mode(gas):
     assert gas.sim.escaped() == 0
 
 
+def test_frames_carry_the_piston_and_its_collisions_stay_on():
+    session = ViewerSession(preset("piston", n=50), preset="piston")
+    session.step()
+    frame = protocol.decode_frame(session.frame(1))
+    piston = session.sim.piston()
+    assert piston is not None
+    np.testing.assert_array_equal(
+        frame["piston"], session.sim.container.piston_line(piston.position).astype(np.float32)
+    )
+    with pytest.raises(InputError) as caught:
+        session.enable_collisions(False)
+    assert caught.value.field == "collisions"
+    assert session.sim.collisions == "exact"
+
+
 def test_charges_switch_the_forces_off_and_on():
     session = ViewerSession(preset("charged-gas", n=50))
     assert session.scene()["has_charges"]

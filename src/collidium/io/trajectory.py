@@ -51,6 +51,9 @@ LOG_KEYS = {
     "impulse/walls": "momentum received by each wall, in the vessel's wall order, kg m/s",
     "heat/walls": "energy each wall has given the disks (thermal, inelastic walls), J",
     "virial/forces": "pair virial of the forces now, J",
+    "piston/position": "where the piston's face is along its axis, m (with a piston only)",
+    "piston/velocity": "the piston's velocity along its axis, m/s (with a piston only)",
+    "piston/work": "work the piston has done on the gas since the start, J (with a piston only)",
 }
 
 
@@ -107,6 +110,10 @@ def frame_of(sim: Simulation) -> gsd.hoomd.Frame:
         "heat/walls": sim.tally.heat[1:],
         "virial/forces": sim.virial(),
     }
+    piston = sim.piston()
+    if piston is not None:
+        values |= {"piston/position": piston.position, "piston/velocity": piston.velocity,
+                   "piston/work": piston.work}  # fmt: skip
     frame.log = {key: np.atleast_1d(np.asarray(value)) for key, value in values.items()}
     return frame
 

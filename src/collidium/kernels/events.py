@@ -48,6 +48,7 @@ from collidium.kernels import wall_responses
 from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import energy_change, pair_response
 from collidium.kernels.vessels import BOX, contacts
+from collidium.kernels.vessels import piston as pistons
 
 #: Columns of the ``body`` rows. RADIUS and MASS exist only in rows of `BODY_COLUMNS`; rows of
 #: `SHARED_BODY_COLUMNS` take them from ``geometry``.
@@ -280,16 +281,21 @@ def _heap_build(keys, items, where) -> None:
 
 
 @_engine(inline="always")
-def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid, segments):
-    """Earliest wall contact or cell crossing of a disk at (x, y) in cell c: ``(delay in s,
-    code)``. Ties go to the first found: walls before cells, x before y."""
+def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid, segments, piston, now):
+    """Earliest wall contact or cell crossing of a disk at (x, y) in cell c at time ``now``
+    (s): ``(delay in s, code)``. Ties go to the first found: walls before cells, x before y.
+    With a piston (a non-empty ``piston``, `collidium.kernels.vessels.piston`) its wall of the
+    box moves."""
     hw = geometry[HALF_WIDTH]
     hh = geometry[HALF_HEIGHT]
     ncx = grid[0]
     periodic = grid[2] != 0
     best = math.inf
     code = NO_EVENT
-    if not periodic:
+    if piston.shape[0] > 0:
+        best, contact = pistons.earliest(x, y, vx, vy, r, hw, hh, piston, now)
+        code = FIRST_WALL_CODE - contact
+    elif not periodic:
         best, contact = contacts.earliest(x, y, vx, vy, r, geometry[SHAPE], hw, hh, geometry[RIM],
                                           segments)  # fmt: skip
         if contact >= 0:
@@ -377,7 +383,7 @@ def _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry, g
 
 @_engine(inline="always")
 def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, count, event,
-            segments):  # fmt: skip
+            segments, piston):  # fmt: skip
     """Find slot k's next event after time ``now`` (s), store it, return its time (s).
 
     The earliest pair contact found is kept (``event[k, KEPT]``): after a cell crossing in
@@ -389,7 +395,8 @@ def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, 
 
     ``geometry`` holds the half sides of the grid's box, the cell sides, any shared radius and
     mass and the vessel's shape (`HALF_WIDTH` to `RIM`); ``grid`` is ``[ncx, ncy, periodic]``;
-    ``segments`` is the vessel's segment table (`collidium.kernels.vessels.segments`). Ties go
+    ``segments`` is the vessel's segment table (`collidium.kernels.vessels.segments`) and
+    ``piston`` its piston (`collidium.kernels.vessels.piston`; empty for none). Ties go
     to the first found in a fixed order (walls, cells, then the partner with the lowest ident),
     so the outcome does not depend on the slot order.
     """
@@ -399,7 +406,8 @@ def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, 
     x = body[k, X] + vx * lag
     y = body[k, Y] + vy * lag
     r = _radius(k, body, geometry)
-    when, code = _walls_and_cells(x, y, vx, vy, r, cell_of[k], geometry, grid, segments)
+    when, code = _walls_and_cells(x, y, vx, vy, r, cell_of[k], geometry, grid, segments, piston,
+                                  now)  # fmt: skip
     when += now
     pair = -1
     if r > 0.0:
@@ -535,7 +543,7 @@ def sort_slots(body, cell_of, event, head, next_, items, where) -> None:
 
 @_engine()
 def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event, keys, items,
-            where, segments) -> None:  # fmt: skip
+            where, segments, piston) -> None:  # fmt: skip
     """Start a fresh queue at time ``now`` (s) from positions synchronised at ``now``.
 
     ``body``'s positions, velocities, radii and masses and ``ident`` are filled by the caller (see
@@ -558,7 +566,7 @@ def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event
     sort_slots(body, cell_of, event, head, next_, items, where)
     for k in range(n):
         keys[k] = predict(k, now, -1, body, ident, geometry, grid, cell_of, head, next_, count,
-                          event, segments)  # fmt: skip
+                          event, segments, piston)  # fmt: skip
     _heap_build(keys, items, where)
 
 
@@ -590,6 +598,7 @@ def run_events(
     walls: np.ndarray,
     heat: np.ndarray,
     segments: np.ndarray,
+    piston: np.ndarray,
 ) -> int:
     """Process every event up to time ``until`` (inclusive) in time order.
 
@@ -625,6 +634,9 @@ def run_events(
         Incremented like ``impulse``'s wall entries by the energy each wall gives the disks (J).
     segments : ndarray, shape (S, 9)
         The vessel's segments (`collidium.kernels.vessels.segments`).
+    piston : ndarray, shape (`pistons.PISTON_SIZE`,) or (0,)
+        The vessel's piston, moved in place (`collidium.kernels.vessels.piston`); its hits add
+        the work it does on the gas to its wall's ``heat``. Empty without one.
     (other arrays)
         Engine state as built by `rebuild`; updated in place.
 
@@ -648,6 +660,15 @@ def run_events(
             sort_slots(body, cell_of, event, head, next_, items, where)
             since_sort = 0
         t = keys[0]
+        if piston.shape[0] > 0 and piston[pistons.NEXT] < t:
+            # The piston reaches an end of its travel first.
+            if piston[pistons.NEXT] > until:
+                break
+            pistons.arrive(piston)
+            _piston_moved(piston[pistons.STAMP], body, ident, geometry, grid, cell_of, head,
+                          next_, count, event, keys, items, where, segments, piston)  # fmt: skip
+            processed += 1
+            continue
         if t > until:
             break
         k = earliest(keys, items, ident)
@@ -663,6 +684,7 @@ def run_events(
             return -1 - ident[k]
         code = event[k, CODE]
         crossed = -1
+        pushed = False
         if code >= 0:
             j = code
             if count[j] == event[k, PARTNER_COUNT]:
@@ -671,8 +693,12 @@ def run_events(
                 count[k] += 1
                 count[j] += 1
                 t_j = predict(j, t, -1, body, ident, geometry, grid, cell_of, head, next_,
-                              count, event, segments)  # fmt: skip
+                              count, event, segments, piston)  # fmt: skip
                 heap_update(j, t_j, keys, items, where)
+        elif piston.shape[0] > 0 and code == FIRST_WALL_CODE - piston[pistons.WALL]:
+            _push_piston(k, t, body, ident, geometry, tally, impulse, heat, piston)
+            count[k] += 1
+            pushed = True
         elif code <= FIRST_WALL_CODE:
             _bounce(k, FIRST_WALL_CODE - code, t, body, ident, geometry, tally, impulse,
                     acceleration, midpoint, walls, heat, segments)  # fmt: skip
@@ -682,9 +708,55 @@ def run_events(
             _advance(k, t, body)
             _cross_cell(k, crossed, body, ident, image, geometry, grid, cell_of, head, next_)
         t_k = predict(k, t, crossed, body, ident, geometry, grid, cell_of, head, next_, count,
-                      event, segments)  # fmt: skip
+                      event, segments, piston)  # fmt: skip
         heap_update(k, t_k, keys, items, where)
+        if pushed:
+            _piston_moved(t, body, ident, geometry, grid, cell_of, head, next_, count, event,
+                          keys, items, where, segments, piston)  # fmt: skip
     return processed
+
+
+@_engine()
+def _push_piston(k, t, body, ident, geometry, tally, impulse, heat, piston):
+    """Slot k hits the piston at time t (s): snapped onto its face, both respond
+    (`collidium.kernels.vessels.piston.hit`); the hit, the momentum and the work done on the gas
+    are booked on the piston's wall."""
+    _advance(k, t, body)
+    x, y, _, _ = pistons.touch(piston, t, body[k, X], body[k, Y], _radius(k, body, geometry))
+    body[k, X] = x
+    body[k, Y] = y
+    m = _mass(k, body, geometry)
+    vx, vy, received, work = pistons.hit(piston, t, body[k, VX], body[k, VY], m,
+                                         geometry[ELASTIC_BELOW])  # fmt: skip
+    body[k, VX] = vx
+    body[k, VY] = vy
+    pistons.schedule(piston)
+    wall = WALL_HITS + int(piston[pistons.WALL])
+    tally[wall] += 1
+    impulse[wall] += received
+    heat[wall] += work
+
+
+@_engine()
+def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count, event, keys,
+                  items, where, segments, piston) -> None:  # fmt: skip
+    """The piston's path changed at time ``now`` (s): every disk whose next event was a contact
+    with it is predicted again, and every other that now meets it sooner than its next event
+    takes that contact. O(N) per change of the piston's path, a few ns per disk."""
+    code = FIRST_WALL_CODE - int(piston[pistons.WALL])
+    for k in range(body.shape[0]):
+        if event[k, CODE] == code:
+            t_k = predict(k, now, -1, body, ident, geometry, grid, cell_of, head, next_, count,
+                          event, segments, piston)  # fmt: skip
+            heap_update(k, t_k, keys, items, where)
+            continue
+        lag = now - body[k, STAMP]
+        vx, vy = body[k, VX], body[k, VY]
+        when = now + pistons.delay(piston, now, body[k, X] + vx * lag, body[k, Y] + vy * lag, vx,
+                                   vy, _radius(k, body, geometry))  # fmt: skip
+        if when < keys[where[k]]:
+            event[k, CODE] = code
+            heap_update(k, when, keys, items, where)
 
 
 @_engine(inline="always")

@@ -614,3 +614,112 @@ def _expansion(
             w += c * (big_d(m) + softening2 * big_d(m + 1)) * t
             field -= c * ((big_d(m + 1) * t)[:, None] * r + big_d(m)[:, None] * grad_t)
     return field, phi, w
+
+
+def piston_contact(gap: float, rate: float, pull: float) -> float:
+    """Twin of `vessels.piston.first_contact`: the least root t >= 0 of
+    ``gap + rate t + pull t^2 / 2`` at which the gap is closing (a touch, later on, counts; at
+    t = 0 a gap that only starts to open does not), by `numpy.roots`; inf if none."""
+    gap = max(gap, 0.0)
+    roots = np.roots([0.5 * pull, rate, gap]) if pull or rate else np.array([])
+    closing = []
+    for root in np.atleast_1d(roots):
+        t = float(root.real)
+        if abs(root.imag) > 1e-12 * max(1.0, abs(t)) or t < 0.0:
+            continue
+        slope = rate + pull * t
+        if slope < 0.0 or (slope == 0.0 and (t > 0.0 or pull < 0.0)):
+            closing.append(t)
+    return min(closing, default=math.inf)
+
+
+def moving_wall(
+    outward: float, wall: float, mass: float, wall_mass: float, restitution: float
+) -> tuple[float, float]:
+    """Twin of `wall_responses.moving_wall`, in the centre-of-mass frame: each normal velocity
+    relative to the centre of mass is reversed and scaled by e (the wall's own frame when it is
+    driven, of infinite mass)."""
+    if math.isinf(wall_mass):
+        return wall - restitution * (outward - wall), wall
+    centre = (mass * outward + wall_mass * wall) / (mass + wall_mass)
+    return centre - restitution * (outward - centre), centre - restitution * (wall - centre)
+
+
+def piston_drift(
+    position: FloatArray,
+    velocity: FloatArray,
+    mass: FloatArray,
+    radius: FloatArray,
+    half: FloatArray,
+    duration: float,
+    wall: int,
+    piston: dict[str, float],
+) -> tuple[int, int, FloatArray, float]:
+    """Event-driven hard disks in a box of half sides ``half`` (m) whose wall ``wall`` (0 left,
+    1 right, 2 bottom, 3 top) is a piston, all pairs checked at every event.
+
+    ``piston`` holds ``height`` and ``speed`` along the outward normal (m, m/s; updated in
+    place), ``pull`` (m/s^2), ``mass`` (kg, inf when driven), ``restitution``, ``low`` and
+    ``high`` (the ends of its travel, m) and ``driven`` (1: it stops at an end; 0: bounces).
+    Positions and velocities (N, 2) are updated in place. Returns (pair collisions, wall hits,
+    momentum received by each of the four walls, work done by the piston on the disks).
+    """
+    axis, sign = wall // 2, (1.0 if wall % 2 == 1 else -1.0)
+    now, pairs, hits, work = 0.0, 0, 0, 0.0
+    impulse = np.zeros(4)
+    p = piston
+
+    def piston_at(t: float) -> tuple[float, float]:
+        return p["height"] + p["speed"] * t + 0.5 * p["pull"] * t * t, p["speed"] + p["pull"] * t
+
+    while True:
+        t_pair, i, j = _next_contact(position, velocity, radius, 2 * half, False)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            target = np.where(velocity > 0, half - radius[:, None], radius[:, None] - half)
+            delays = np.where(velocity != 0, np.maximum((target - position) / velocity, 0), np.inf)
+        towards = 2 * np.arange(2)[None, :] + (velocity > 0)
+        delays[towards == wall] = np.inf  # the piston's wall is where the piston is
+        k, d = np.unravel_index(np.argmin(delays), delays.shape)
+        t_wall = float(delays[k, d])
+        gaps = [p["height"] - sign * position[q, axis] - radius[q] for q in range(len(radius))]
+        t_disks = [
+            piston_contact(g, p["speed"] - sign * velocity[q, axis], p["pull"])
+            for q, g in enumerate(gaps)
+        ]
+        q = int(np.argmin(t_disks)) if t_disks else -1
+        t_piston = t_disks[q] if t_disks else math.inf
+        t_end = min(
+            piston_contact(p["high"] - p["height"], -p["speed"], -p["pull"]),
+            piston_contact(p["height"] - p["low"], p["speed"], p["pull"]),
+        )
+        best = min(t_pair, t_wall, t_piston, t_end)
+        if now + best > duration:
+            left = duration - now
+            position += velocity * left
+            p["height"], p["speed"] = piston_at(left)
+            return pairs, hits, impulse, work
+        position += velocity * best
+        now += best
+        p["height"], p["speed"] = piston_at(best)
+        if t_end == best:
+            upper = abs(p["height"] - p["high"]) <= abs(p["height"] - p["low"])
+            p["height"] = p["high"] if upper else p["low"]
+            p["speed"] = 0.0 if p["driven"] else -p["speed"]
+        elif t_wall == best:
+            impulse[2 * d + int(velocity[k, d] > 0)] += 2 * mass[k] * abs(velocity[k, d])
+            velocity[k, d] = -velocity[k, d]
+            hits += 1
+        elif t_piston == best:
+            outward = sign * velocity[q, axis]
+            after, p["speed"] = moving_wall(outward, p["speed"], mass[q], p["mass"],
+                                            p["restitution"])  # fmt: skip
+            impulse[wall] += mass[q] * (outward - after)
+            work += 0.5 * mass[q] * (after * after - outward * outward)
+            velocity[q, axis] = sign * after
+            hits += 1
+        else:
+            sep = position[i] - position[j]
+            velocity[i], velocity[j] = pair_response(
+                mass[i], mass[j], sep, np.zeros(2), velocity[i], velocity[j]
+            )
+            pairs += 1

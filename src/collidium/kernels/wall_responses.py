@@ -8,7 +8,9 @@ A vessel's walls are described by a table, one row per wall (`collidium.vessels.
   ``e`` in (0, 1] (the parameter);
 - `THERMAL`: the disk is re-emitted with a fresh velocity from the wall's Maxwell flux
   distribution at temperature ``kT`` (the parameter, J): normal speed with density
-  ``m v / kT exp(-m v^2 / 2 kT)``, tangential velocity normal with variance ``kT / m``.
+  ``m v / kT exp(-m v^2 / 2 kT)``, tangential velocity normal with variance ``kT / m``;
+- `PISTON`: a moving wall of mass M (`moving_wall`); the parameter is the restitution of its
+  collisions. Its motion is the engine's (`collidium.kernels.vessels.piston`).
 
 Random numbers for thermal walls come from a counter-based generator (SplitMix64) keyed by the
 wall's key, the particle and the wall's hit count, so a run is the same whatever the engine's
@@ -23,7 +25,7 @@ import numba
 import numpy as np
 
 #: Response codes of the wall table.
-SPECULAR, INELASTIC, THERMAL = 0, 1, 2
+SPECULAR, INELASTIC, THERMAL, PISTON = 0, 1, 2, 3
 
 #: Columns of a wall table row.
 RESPONSE, PARAMETER, KEY = range(3)
@@ -127,3 +129,33 @@ def hit(table, wall, vx, vy, nx, ny, mass, particle, hits, impulse, heat, slot):
     impulse[slot] += received
     heat[slot] += gained
     return wx, wy
+
+
+@numba.njit(cache=True, inline="always")
+def moving_wall(
+    outward: float, wall: float, mass: float, wall_mass: float, restitution: float
+) -> tuple[float, float]:
+    """A disk meets a wall that moves along its normal (a piston): the normal velocities after.
+
+    Parameters
+    ----------
+    outward, wall : float
+        The disk's and the wall's velocity along the wall's outward normal, m/s (the disk
+        approaches when ``outward > wall``).
+    mass, wall_mass : float
+        The disk's and the wall's mass, kg; an infinite ``wall_mass`` is a wall driven at a set
+        velocity, which no hit changes.
+    restitution : float
+        The normal restitution e in (0, 1]: the relative normal velocity is reversed and scaled
+        by e.
+
+    Returns
+    -------
+    tuple of float
+        ``(outward, wall)`` after the hit (m/s). Momentum is conserved for a finite wall mass.
+    """
+    approach = outward - wall
+    if math.isinf(wall_mass):
+        return outward - (1.0 + restitution) * approach, wall
+    share = (1.0 + restitution) * approach / (mass + wall_mass)
+    return outward - wall_mass * share, wall + mass * share

@@ -5,7 +5,8 @@ Boltzmann's constant is 1, so temperatures are kT in J; in 2D pressure is a forc
 the centres move in the vessel shrunk by the mean radius r: the wall pressure of a wall is the
 normal force on it per unit length of its line of contact (`Vessel.contact_lengths`), and the
 virial pressure uses the area that line encloses (`Vessel.available_area`; for a box
-``A_c = (Lx - 2 r) (Ly - 2 r)``, ``Lx Ly`` when periodic),
+``A_c = (Lx - 2 r) (Ly - 2 r)``, ``Lx Ly`` when periodic; with a piston, both are taken where
+it is at each sample),
 
     P_virial = (N kT + W / 2) / A_c,    W = <sum_{i<j} r_ij . F_ij> (collisions and forces).
 
@@ -68,25 +69,38 @@ class Thermo(Measurement):
         self._kT: list[float] = []
         self._impulse: list[FloatArray] = []
         self._force_virial: list[float] = []
+        self._contact: list[FloatArray] = []
+        self._area: list[float] = []
 
     def _start(self, sim: Simulation) -> None:
         self._time, self._kT, self._impulse, self._force_virial = [], [], [], []
+        self._contact, self._area = [], []
         self.n = sim.particles.n
-        vessel = sim.container
-        radius = float(np.mean(sim.particles.radius)) if self.n > 0 else 0.0
-        self.periodic = vessel.periodic
+        self._radius = float(np.mean(sim.particles.radius)) if self.n > 0 else 0.0
+        self.periodic = sim.container.periodic
         #: The vessel's walls, in the order of the wall counters.
-        self.walls = vessel.wall_names
-        #: Length (m) of each wall's line of contact for disks of the mean radius.
-        self.contact = vessel.contact_lengths(radius)
-        #: Area (m^2) the centres move in.
-        self.area = vessel.available_area(radius)
+        self.walls = sim.container.wall_names
 
     def _sample(self, sim: Simulation) -> None:
         self._time.append(sim.time)
         self._kT.append(sim.temperature())
         self._impulse.append(sim.tally.impulse.copy())
         self._force_virial.append(sim.virial())
+        state = sim.piston()
+        piston = None if state is None else state.position
+        self._contact.append(sim.container.contact_lengths(self._radius, piston))
+        self._area.append(sim.container.available_area(self._radius, piston))
+
+    @property
+    def contact(self) -> FloatArray:
+        """Length (m) of each wall's line of contact for disks of the mean radius, averaged
+        over the samples (it changes only with a piston)."""
+        return np.mean(self._contact, axis=0)
+
+    @property
+    def area(self) -> float:
+        """Area (m^2) the centres move in, averaged over the samples."""
+        return float(np.mean(self._area))
 
     def _intervals(self) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """Per sampled interval: duration, impulse sums gained, kT and force virial at its end."""

@@ -16,7 +16,14 @@ from collidium.vessels.box import Box
 from collidium.vessels.circle import Circle
 from collidium.vessels.partitions import Partition, partition_from_dict
 from collidium.vessels.polygon import Polygon, regular_polygon
-from collidium.vessels.walls import Inelastic, Specular, Thermal, WallResponse, response_from_dict
+from collidium.vessels.walls import (
+    Inelastic,
+    Piston,
+    Specular,
+    Thermal,
+    WallResponse,
+    response_from_dict,
+)
 
 #: Vessel classes by their `Vessel.kind` (the ``shape`` of a scenario file or checkpoint).
 VESSELS: dict[str, type[Vessel]] = {cls.kind: cls for cls in (Box, Circle, Polygon)}
@@ -47,6 +54,7 @@ __all__ = [
     "Circle",
     "Inelastic",
     "Partition",
+    "Piston",
     "Polygon",
     "Specular",
     "Thermal",

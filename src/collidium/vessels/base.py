@@ -15,7 +15,13 @@ from collidium.kernels.vessels import contacts
 from collidium.kernels.vessels import segments as segment_kernels
 from collidium.state import BoolArray, FloatArray, IntArray
 from collidium.vessels.partitions import Partition, distances
-from collidium.vessels.walls import WallResponse, checked_walls, response_to_dict, wall_table
+from collidium.vessels.walls import (
+    Piston,
+    WallResponse,
+    checked_walls,
+    response_to_dict,
+    wall_table,
+)
 
 #: Relative round-off allowance when deciding that a disk pokes out of a vessel.
 OUTSIDE_TOLERANCE = 1e-9
@@ -48,6 +54,7 @@ class Vessel(ABC):
         self.partitions = tuple(partitions)
         self._check_partitions()
         self.walls = checked_walls(self.wall_names, walls)
+        self._check_pistons()
         self._wall_table = wall_table(self.wall_names, self.walls)
         own = len(self.shape_walls)
         inner = [partition.segments(own + j) for j, partition in enumerate(self.partitions)]
@@ -123,28 +130,37 @@ class Vessel(ABC):
         corners); none by default."""
         return np.empty((0, segment_kernels.SEGMENT_COLUMNS))
 
-    def available_area(self, radius: float) -> float:
+    def available_area(self, radius: float, piston_at: float | None = None) -> float:
         """Area in m^2 that the centres of disks of ``radius`` m can reach: the shape's, less
-        the partitions' (`Partition.excluded_area`)."""
+        the partitions' (`Partition.excluded_area`); with a piston, on the gas's side of its
+        face at ``piston_at`` (m along its axis; default: where it starts)."""
         blocked = sum(partition.excluded_area(radius) for partition in self.partitions)
-        return self._open_area(radius) - blocked
+        return self._chamber(piston_at)._open_area(radius) - blocked
+
+    def _chamber(self, piston_at: float | None) -> Vessel:
+        """The vessel the gas has with the piston's face at ``piston_at``: itself, without a
+        piston."""
+        return self
 
     @abstractmethod
     def _open_area(self, radius: float) -> float:
         """Area in m^2 that the centres of disks of ``radius`` m can reach in the shape."""
 
-    def contact_lengths(self, radius: float) -> FloatArray:
+    def contact_lengths(self, radius: float, piston_at: float | None = None) -> FloatArray:
         """Length in m of each wall's line of contact for disks of ``radius`` m: the line their
         centres are on when they touch it, by wall (`wall_names` order), shape (W,). The wall
-        pressure is the normal impulse per unit time per unit of it."""
+        pressure is the normal impulse per unit time per unit of it. With a piston, its face
+        is at ``piston_at`` (m along its axis; default: where it starts)."""
         inner = [partition.contact_length(radius) for partition in self.partitions]
-        return np.concatenate([self._shape_contact_lengths(radius), inner])
+        return np.concatenate([self._chamber(piston_at)._shape_contact_lengths(radius), inner])
 
     @abstractmethod
     def _shape_contact_lengths(self, radius: float) -> FloatArray:
         """`contact_lengths` of the shape's own walls, shape (len(shape_walls),)."""
 
-    def outside(self, position: FloatArray, radius: FloatArray) -> IntArray:
+    def outside(
+        self, position: FloatArray, radius: FloatArray, piston_at: float | None = None
+    ) -> IntArray:
         """Indices of the disks not inside the vessel.
 
         Parameters
@@ -153,20 +169,30 @@ class Vessel(ABC):
             Centres in m.
         radius : ndarray, shape (N,)
             Radii in m.
+        piston_at : float, optional
+            Where the piston's face is now (m, along its axis); default: where it starts.
 
         Returns
         -------
         ndarray of int, shape (M,)
-            Disks that reach past a wall or closer to a partition than their radius by more
-            than round-off, or whose centre is not finite.
+            Disks that reach past a wall (the piston's face included) or closer to a partition
+            than their radius by more than round-off, or whose centre is not finite.
         """
         position = np.asarray(position, dtype=float)
         bad = self._outside_shape(position, radius) | ~np.isfinite(position).all(axis=1)
+        bad |= self._past_piston(position, radius, piston_at)
         if len(self.partitions) and len(position):
             table = self._segments[self._segments[:, segment_kernels.BOUNDARY] == 0.0]
             near = distances(np.nan_to_num(position), table).min(axis=1)
             bad |= near < radius - self._slack
         return np.flatnonzero(bad).astype(np.int64)
+
+    def _past_piston(
+        self, position: FloatArray, radius: FloatArray, piston_at: float | None
+    ) -> BoolArray:
+        """Which disks reach past the piston's face at ``piston_at`` (m), shape (N,); none
+        without a piston."""
+        return np.zeros(len(position), dtype=bool)
 
     @abstractmethod
     def _outside_shape(self, position: FloatArray, radius: FloatArray) -> BoolArray:
@@ -194,6 +220,34 @@ class Vessel(ABC):
             points = np.array(partition.start) + along * np.subtract(partition.end, partition.start)
             if self._outside_shape(points, np.zeros(len(points))).any():
                 raise InputError(field, f"must lie inside the {self.describe()}")
+
+    @property
+    def piston(self) -> tuple[int, Piston] | None:
+        """The wall that is a piston, as ``(index in wall_names, Piston)``, or None."""
+        for index, name in enumerate(self.wall_names):
+            response = self.walls.get(name)
+            if isinstance(response, Piston):
+                return index, response
+        return None
+
+    def _check_pistons(self) -> None:
+        """Refuse pistons where the shape has none (`collidium.vessels.box.Box` has them)."""
+        for name, response in self.walls.items():
+            if isinstance(response, Piston):
+                raise InputError(
+                    f"vessel.walls.{name}", "a piston is one of a reflecting box's four walls"
+                )
+
+    def piston_line(self, piston_at: float | None = None) -> FloatArray:
+        """The piston's face as drawn, ``[start, end]`` in m, shape (2, 2), with it at
+        ``piston_at`` (m along its axis; default: where it starts); shape (0, 2) without one."""
+        return np.empty((0, 2))
+
+    def piston_array(self, position: float, velocity: float, now: float) -> FloatArray:
+        """The exact engine's piston (`collidium.kernels.vessels.piston`) with its face at
+        ``position`` (m) moving at ``velocity`` (m/s) along its axis at time ``now`` (s);
+        empty for a vessel without one."""
+        return np.empty(0)
 
     @abstractmethod
     def check_fits(self, radius: FloatArray) -> None:

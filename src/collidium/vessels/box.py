@@ -17,7 +17,7 @@ from collidium.kernels.vessels import box as box_walls
 from collidium.state import BoolArray, FloatArray, IntArray
 from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
 from collidium.vessels.partitions import Partition
-from collidium.vessels.walls import WallResponse
+from collidium.vessels.walls import Piston, WallResponse, piston_array
 
 Boundary = Literal["reflecting", "periodic"]
 BOUNDARIES: tuple[Boundary, ...] = ("reflecting", "periodic")
@@ -42,6 +42,10 @@ class Box(Vessel):
         Responses of walls that are not mirrors, by name (``{"left": Thermal(2.0)}``).
     partitions : sequence of Partition, optional
         Straight walls inside (a reflecting box only).
+
+    One wall of a reflecting box may be a `collidium.vessels.walls.Piston`
+    (``walls={"top": Piston(position=5.0, mass=10.0, force=20.0)}``): it moves along its axis
+    between the box's edge behind it and the opposite wall.
     """
 
     kind: ClassVar[str] = "box"
@@ -204,6 +208,77 @@ class Box(Vessel):
             return x + (v + 0.5 * a * s) * s - target, v + a * s
 
         return gap
+
+    def _check_pistons(self) -> None:
+        """A piston is one of a reflecting box's walls, at most one, in a box without
+        partitions, its face and any stop inside the box."""
+        found = [(name, r) for name, r in self.walls.items() if isinstance(r, Piston)]
+        if not found:
+            return
+        name, piston = found[0]
+        field = f"vessel.walls.{name}"
+        if len(found) > 1:
+            raise InputError(f"vessel.walls.{found[1][0]}", "a box has at most one piston")
+        if self.partitions:
+            raise InputError(field, "a piston needs a box without partitions (it would cross them)")
+        half = 0.5 * float(self.size[WALLS.index(name) // 2])
+        sign = 1.0 if WALLS.index(name) % 2 == 1 else -1.0
+        if not -half < sign * piston.position <= half:
+            raise InputError(
+                f"{field}.position",
+                f"must be inside the box: in ({-half:g}, {half:g}] from its centre towards the "
+                f"{name}, got {piston.position!r}",
+            )
+        if piston.stop is not None:
+            ahead = sign * (piston.stop - piston.position) * np.sign(sign * piston.velocity)
+            if not (-half <= sign * piston.stop <= half and ahead >= 0):
+                raise InputError(
+                    f"{field}.stop", "must be inside the box and ahead of the piston's motion"
+                )
+
+    def piston_array(self, position: float, velocity: float, now: float) -> FloatArray:
+        """`Vessel.piston_array` for the box's piston."""
+        if self.piston is None:
+            return np.empty(0)
+        wall, piston = self.piston
+        half = 0.5 * float(self.size[wall // 2])
+        return piston_array(wall, piston, half, position, velocity, now)
+
+    def _chamber(self, piston_at: float | None) -> Vessel:
+        """A box of the gas's side of the piston, without one (the same box without a
+        piston)."""
+        if self.piston is None:
+            return self
+        wall, piston = self.piston
+        face = piston.position if piston_at is None else piston_at
+        axis = wall // 2
+        sign = 1.0 if wall % 2 == 1 else -1.0
+        sides = [self.width, self.height]
+        sides[axis] = sign * face + 0.5 * sides[axis]
+        return Box(sides[0], sides[1])
+
+    def piston_line(self, piston_at: float | None = None) -> FloatArray:
+        """`Vessel.piston_line`: across the box at the piston's face."""
+        if self.piston is None:
+            return np.empty((0, 2))
+        wall, piston = self.piston
+        face = piston.position if piston_at is None else piston_at
+        axis = wall // 2
+        line = np.array(self.bounds)  # [[x0, y0], [x1, y1]]: the other axis spans the box
+        line[:, axis] = face
+        return line
+
+    def _past_piston(
+        self, position: FloatArray, radius: FloatArray, piston_at: float | None
+    ) -> BoolArray:
+        """Disks reaching past the piston's face by more than round-off."""
+        if self.piston is None:
+            return np.zeros(len(position), dtype=bool)
+        wall, piston = self.piston
+        face = piston.position if piston_at is None else piston_at
+        sign = 1.0 if wall % 2 == 1 else -1.0
+        reach = sign * (position[:, wall // 2] - face) + radius
+        return np.asarray(reach > OUTSIDE_TOLERANCE * 0.5 * float(self.size.max()))
 
     def describe(self) -> str:
         """``'20 x 10 box (centred on 0, 0)'``, with ``periodic`` when it is."""

@@ -1,5 +1,7 @@
 """Wall responses, chosen per wall of any vessel: `Specular` (the default), `Inelastic`,
-`Thermal`. The arithmetic is in `collidium.kernels.wall_responses`, which every engine uses."""
+`Thermal`, and `Piston`, a wall of a box that moves. The arithmetic is in
+`collidium.kernels.wall_responses`, which every engine uses, and the piston's motion in
+`collidium.kernels.vessels.piston`."""
 
 from __future__ import annotations
 
@@ -11,6 +13,7 @@ import numpy as np
 
 from collidium.errors import InputError
 from collidium.kernels import wall_responses
+from collidium.kernels.vessels import piston as piston_kernels
 from collidium.state import FloatArray
 
 
@@ -43,9 +46,7 @@ class Inelastic:
     code: ClassVar[int] = wall_responses.INELASTIC
 
     def __post_init__(self) -> None:
-        e = self.restitution
-        if not (isinstance(e, int | float) and 0.0 < e <= 1.0):
-            raise InputError("restitution", f"must be in (0, 1], got {e!r}")
+        check_restitution(self.restitution)
 
     @property
     def parameter(self) -> float:
@@ -82,10 +83,116 @@ class Thermal:
         return float(self.temperature)
 
 
-WallResponse = Specular | Inelastic | Thermal
+@dataclass(frozen=True)
+class Piston:
+    """A wall of a reflecting box that moves along its normal between guides, its ends being
+    the box's edge behind it and the opposite wall (exact engine only).
+
+    A free piston has a mass, may feel a constant external force pushing it into the gas (a
+    weight, an outside pressure times its length) and collides with the disks as an exact event
+    (`collidium.kernels.wall_responses.moving_wall`); at an end of its guides it bounces back. A
+    driven piston moves at a set velocity, whatever hits it, until it reaches ``stop``. Its
+    position and velocity are `collidium.simulation.Simulation.piston`'s; the work it does on
+    the gas is its wall's `collidium.simulation.Simulation.wall_heat`.
+
+    Parameters
+    ----------
+    position : float
+        Where its face starts, m, as a coordinate along its axis (the y of a top or bottom
+        piston, the x of a left or right one).
+    mass : float
+        kg, > 0 (unused when driven).
+    force : float
+        External force pushing it into the box, N (>= 0; 0 when driven).
+    velocity : float
+        Starting velocity along its axis, m/s (> 0 towards +x or +y); a driven piston keeps it.
+    driven : bool
+        Moved at ``velocity`` whatever the disks do (compression or expansion at a set rate).
+    stop : float, optional
+        Where a driven piston halts, m, a coordinate along its axis (default: the end of its
+        guides).
+    restitution : float
+        Normal restitution of its collisions with disks, in (0, 1].
+    """
+
+    position: float
+    mass: float = 1.0
+    force: float = 0.0
+    velocity: float = 0.0
+    driven: bool = False
+    stop: float | None = None
+    restitution: float = 1.0
+    name: ClassVar[str] = "piston"
+    code: ClassVar[int] = wall_responses.PISTON
+
+    def __post_init__(self) -> None:
+        for field in ("position", "velocity", "force", "mass"):
+            if not _finite(getattr(self, field)):
+                raise InputError(field, f"must be a finite number, got {getattr(self, field)!r}")
+        if self.mass <= 0:
+            raise InputError("mass", f"must be > 0, got {self.mass!r}")
+        if self.force < 0:
+            raise InputError("force", f"must be >= 0 (it pushes into the box), got {self.force!r}")
+        if not isinstance(self.driven, bool):
+            raise InputError("driven", f"must be true or false, got {self.driven!r}")
+        if self.driven and self.force != 0:
+            raise InputError("force", "a driven piston keeps its velocity: give no force")
+        if self.stop is not None and not self.driven:
+            raise InputError("stop", "only a driven piston stops; a free one moves freely")
+        if self.stop is not None and not _finite(self.stop):
+            raise InputError("stop", f"must be a finite number, got {self.stop!r}")
+        check_restitution(self.restitution)
+
+    @property
+    def parameter(self) -> float:
+        """The restitution coefficient."""
+        return float(self.restitution)
+
+
+def check_restitution(restitution: object) -> None:
+    """Refuse a normal restitution coefficient outside (0, 1] (field ``restitution``)."""
+    e = restitution
+    if not (isinstance(e, int | float) and not isinstance(e, bool) and 0.0 < e <= 1.0):
+        raise InputError("restitution", f"must be in (0, 1], got {e!r}")
+
+
+def _finite(value: object) -> bool:
+    """A finite number (not a bool)."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+
+
+WallResponse = Specular | Inelastic | Thermal | Piston
 
 #: Response classes by name (the ``response`` of a scenario's wall table).
-RESPONSES: dict[str, type[WallResponse]] = {cls.name: cls for cls in (Specular, Inelastic, Thermal)}
+RESPONSES: dict[str, type[WallResponse]] = {
+    cls.name: cls for cls in (Specular, Inelastic, Thermal, Piston)
+}
+
+
+def piston_array(
+    wall: int, piston: Piston, half: float, position: float, velocity: float, now: float
+) -> FloatArray:
+    """The exact engine's piston (`collidium.kernels.vessels.piston`) for ``piston`` as box
+    wall ``wall`` (0 left, 1 right, 2 bottom, 3 top) of half side ``half`` (m) along its axis,
+    its face at ``position`` (m) moving at ``velocity`` (m/s), both along the axis, at time
+    ``now`` (s)."""
+    k = piston_kernels
+    sign = 1.0 if wall % 2 == 1 else -1.0
+    array = np.zeros(k.PISTON_SIZE)
+    array[k.WALL] = wall
+    array[k.HEIGHT], array[k.SPEED], array[k.STAMP] = sign * position, sign * velocity, now
+    array[k.RESTITUTION] = piston.restitution
+    array[k.LOW], array[k.HIGH] = -half, half
+    if piston.driven:
+        array[k.MASS], array[k.DRIVEN] = math.inf, 1.0
+        if piston.stop is not None:
+            end = sign * piston.stop
+            inward = sign * velocity < 0.0
+            array[k.LOW if inward else k.HIGH] = end
+    else:
+        array[k.MASS], array[k.PULL] = piston.mass, -piston.force / piston.mass
+    piston_kernels.schedule(array)
+    return array
 
 
 def response_to_dict(response: WallResponse) -> dict[str, Any]:
@@ -127,10 +234,10 @@ def checked_walls(
         if name not in names:
             allowed = ", ".join(names) if names else "none (a periodic box has no walls)"
             raise InputError(f"vessel.walls.{name}", f"no such wall; the walls are: {allowed}")
-        if not isinstance(response, Specular | Inelastic | Thermal):
+        if not isinstance(response, Specular | Inelastic | Thermal | Piston):
             raise InputError(
                 f"vessel.walls.{name}",
-                f"must be Specular, Inelastic or Thermal, got {type(response).__name__}",
+                f"must be Specular, Inelastic, Thermal or Piston, got {type(response).__name__}",
             )
         if not isinstance(response, Specular):
             out[name] = response

@@ -25,7 +25,8 @@ toggles), ``stats`` (time, readouts, energies, speed histogram with its Maxwell-
 
 Binary frames (little-endian): ``b"CLD1"``, u32 n, u32 flags (bit 0: velocities follow), u32
 frame number, f64 simulated time (s), u32 scene generation, u32 reserved; then float32 positions
-``x0 y0 x1 y1 ...`` (m) and, with flag bit 0, float32 velocities (m/s). The server sends a frame
+``x0 y0 x1 y1 ...`` (m), with flag bit 0 float32 velocities (m/s) and, with flag bit 1, the
+piston's face as float32 ``x0 y0 x1 y1`` (m) where it is now. The server sends a frame
 only while the front end has credit (two frames unacknowledged at most); a frame always carries
 the state when it is sent, so the latest frame wins.
 """
@@ -64,6 +65,7 @@ MAX_SET_SPEED = 1e6
 FRAME_MAGIC = b"CLD1"
 FRAME_HEADER = struct.Struct("<4sIIIdII")
 FLAG_VELOCITIES = 1
+FLAG_PISTON = 2
 
 
 class _Message(BaseModel):
@@ -199,6 +201,7 @@ def encode_frame(
     generation: int,
     position: FloatArray,
     velocity: FloatArray | None = None,
+    piston: FloatArray | None = None,
 ) -> bytes:
     """One binary frame (see the module docstring).
 
@@ -214,28 +217,37 @@ def encode_frame(
         Positions in m.
     velocity : ndarray, shape (N, 2), optional
         Velocities in m/s, included when given.
+    piston : ndarray, shape (2, 2), optional
+        The piston's face, its two ends in m (`collidium.vessels.Vessel.piston_line`).
     """
     n = position.shape[0]
-    flags = FLAG_VELOCITIES if velocity is not None else 0
+    flags = (FLAG_VELOCITIES if velocity is not None else 0) | (
+        FLAG_PISTON if piston is not None else 0
+    )
     header = FRAME_HEADER.pack(FRAME_MAGIC, n, flags, number & 0xFFFFFFFF, time,
                                generation & 0xFFFFFFFF, 0)  # fmt: skip
     parts = [header, np.ascontiguousarray(position, dtype="<f4").tobytes()]
     if velocity is not None:
         parts.append(np.ascontiguousarray(velocity, dtype="<f4").tobytes())
+    if piston is not None:
+        parts.append(np.ascontiguousarray(piston, dtype="<f4").tobytes())
     return b"".join(parts)
 
 
 def decode_frame(data: bytes) -> dict[str, Any]:
     """The fields of a binary frame (for tests and tools): n, flags, number, time, generation,
-    position (N, 2) and velocity (N, 2) or None."""
+    position (N, 2), velocity (N, 2) or None and piston (2, 2) or None."""
     magic, n, flags, number, time, generation, _ = FRAME_HEADER.unpack_from(data)
     if magic != FRAME_MAGIC:
         raise InputError("frame", f"bad magic {magic!r}")
-    size = FRAME_HEADER.size + 8 * n * (2 if flags & FLAG_VELOCITIES else 1)
+    arrays = 2 if flags & FLAG_VELOCITIES else 1
+    size = FRAME_HEADER.size + 8 * n * arrays + (16 if flags & FLAG_PISTON else 0)
     if len(data) != size:
         raise InputError("frame", f"{len(data)} bytes where {size} were expected")
-    values = np.frombuffer(data, dtype="<f4", offset=FRAME_HEADER.size).reshape(-1, n, 2)
+    values = np.frombuffer(data, dtype="<f4", offset=FRAME_HEADER.size)
+    particles = values[: 2 * n * arrays].reshape(arrays, n, 2)
     return {
         "n": n, "flags": flags, "number": number, "time": time, "generation": generation,
-        "position": values[0], "velocity": values[1] if flags & FLAG_VELOCITIES else None,
+        "position": particles[0], "velocity": particles[1] if flags & FLAG_VELOCITIES else None,
+        "piston": values[2 * n * arrays :].reshape(2, 2) if flags & FLAG_PISTON else None,
     }  # fmt: skip

@@ -353,10 +353,13 @@ class ViewerSession:
         }
 
     def frame(self, number: int) -> bytes:
-        """The binary frame of the current state (velocities included with momentum on)."""
+        """The binary frame of the current state (velocities included with momentum on, the
+        piston's face with a piston)."""
         p = self.sim.particles
+        piston = self.sim.piston()
+        line = None if piston is None else self.sim.container.piston_line(piston.position)
         return protocol.encode_frame(number, self.sim.time, self.generation, p.position,
-                                     p.velocity if self.momentum else None)  # fmt: skip
+                                     p.velocity if self.momentum else None, line)  # fmt: skip
 
     def export(self) -> dict[str, Any]:
         """The scenario that reset returns to, as TOML, with a file name."""

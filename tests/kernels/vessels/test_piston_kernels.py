@@ -1,0 +1,81 @@
+"""The piston's kernels against their NumPy twins: the first contact of a disk with a wall on a
+parabola, and the response of a moving wall of mass M."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from collidium.kernels import reference
+from collidium.kernels.vessels import piston as pistons
+from collidium.kernels.wall_responses import moving_wall
+
+
+def approx(value: float) -> object:
+    """Equal to round-off (np.roots solves an eigenvalue problem)."""
+    return pytest.approx(value, rel=1e-9, abs=1e-12)
+
+
+def _scale(low: float, high: float) -> st.SearchStrategy[float]:
+    """Numbers of the physical scale or 0 (np.roots loses real roots of coefficients near the
+    underflow limit)."""
+    return st.floats(low, high).filter(lambda value: value == 0.0 or abs(value) > 1e-6)
+
+
+@settings(max_examples=300, deadline=None)
+@given(_scale(0.0, 10.0), _scale(-10.0, 10.0), _scale(-10.0, 10.0))
+def test_first_contact_equals_its_twin(gap, rate, pull):
+    got = pistons.first_contact(gap, rate, pull)
+    want = reference.piston_contact(gap, rate, pull)
+    if math.isinf(want):
+        assert math.isinf(got)
+    else:
+        assert got == approx(want)
+        assert abs(gap + rate * got + 0.5 * pull * got * got) <= 1e-9 * (1.0 + gap)
+
+
+def test_first_contact_of_a_falling_piston_on_a_resting_disk():
+    # A gap of 2 m closed by a pull of 4 m/s^2 from rest: t = sqrt(2 gap / pull) = 1 s.
+    assert pistons.first_contact(2.0, 0.0, -4.0) == 1.0
+    assert math.isinf(pistons.first_contact(2.0, 1.0, 0.0))  # opening, no pull
+    assert math.isinf(pistons.first_contact(2.0, -1.0, 1.0))  # turns back before touching
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.floats(-10.0, 10.0), st.floats(-10.0, 10.0), st.floats(0.1, 10.0),
+    st.floats(0.1, 1000.0), st.floats(0.05, 1.0),
+)  # fmt: skip
+def test_moving_wall_equals_its_twin_and_conserves_momentum(outward, wall, m, big, e):
+    got = moving_wall(outward, wall, m, big, e)
+    np.testing.assert_allclose(got, reference.moving_wall(outward, wall, m, big, e), atol=1e-11)
+    assert m * got[0] + big * got[1] == approx(m * outward + big * wall)
+    # Relative normal velocity reversed and scaled by e.
+    assert got[0] - got[1] == approx(-e * (outward - wall))
+
+
+def test_elastic_moving_wall_conserves_energy_and_a_driven_one_keeps_its_speed():
+    w, u = moving_wall(3.0, -1.0, 1.0, 5.0, 1.0)
+    assert 0.5 * w * w + 2.5 * u * u == approx(0.5 * 9.0 + 2.5 * 1.0)
+    w, u = moving_wall(3.0, -1.0, 1.0, math.inf, 1.0)
+    assert (w, u) == (-5.0, -1.0)  # reflected in the wall's frame: 4 m/s in, 4 m/s out
+
+
+def test_piston_at_an_end_bounces_when_free_and_stops_when_driven():
+    piston = np.zeros(pistons.PISTON_SIZE)
+    piston[[pistons.HEIGHT, pistons.SPEED, pistons.MASS, pistons.LOW, pistons.HIGH]] = (
+        0.0, 2.0, 1.0, -5.0, 4.0,
+    )  # fmt: skip
+    pistons.schedule(piston)
+    assert piston[pistons.NEXT] == 2.0
+    pistons.arrive(piston)
+    assert (piston[pistons.HEIGHT], piston[pistons.SPEED]) == (4.0, -2.0)
+    assert piston[pistons.NEXT] == 2.0 + 4.5  # 9 m back to the low end at 2 m/s
+    piston[pistons.DRIVEN] = 1.0
+    pistons.arrive(piston)
+    assert (piston[pistons.HEIGHT], piston[pistons.SPEED]) == (-5.0, 0.0)
+    assert math.isinf(piston[pistons.NEXT])
