@@ -129,6 +129,7 @@ PISTON_STEP = (
         (["run", "{file}"], PISTON_OUTSIDE, "vessel.walls.top.position"),
         (["run", "{file}"], PISTON_STEP, "run.collisions"),
         (["run", "piston", "--set", "force=-1"], None, "force"),
+        (["run", "effusion", "--set", "gap=30"], None, "vessel.partitions.divider.gap"),
         (["run", "head-on", "--dt", "0"], None, "dt"),
         (["run", "head-on", "--dt", "nan"], None, "dt"),
         (["run", "head-on", "--set", "run.dt=nan"], None, "run.dt"),
@@ -244,6 +245,19 @@ def test_run_table_shows_temperature_and_pressure():
     assert result.returncode == 0, result.stderr
     for label in ("temperature kT", "wall pressure", "virial pressure", "KS p-value"):
         assert label in result.stdout
+
+
+def test_run_effusion_reports_each_species_crossings_and_grahams_ratio():
+    result = collidium("run", "effusion", "--time", "30", "--json")
+    assert result.returncode == 0, result.stderr
+    (effusion,) = json.loads(result.stdout)["observers"]
+    assert effusion["observer"] == "Effusion" and effusion["partition"] == "divider"
+    assert effusion["masses"] == [1.0, 4.0] and effusion["graham"] == 2.0
+    assert effusion["crossings"][0] > effusion["crossings"][1] > 0
+    table = collidium("run", "effusion", "--time", "30")
+    assert "lightest / heaviest rate" in table.stdout and "(Graham: 2)" in table.stdout
+    piston = collidium("run", "piston", "--time", "1")
+    assert "piston (top) work on the gas" in piston.stdout
 
 
 def test_trajectory_inspect_and_convert(tmp_path):

@@ -14,7 +14,7 @@ from collidium.initial import (
     rhombus_rack,
     uniform_velocities,
 )
-from collidium.vessels import Box
+from collidium.vessels import Box, Partition
 
 
 def min_gap(position: np.ndarray, radius: np.ndarray) -> float:
@@ -122,3 +122,24 @@ def test_rhombus_rack_shape_and_spacing():
     assert list(columns) == [*range(1, 16), *range(14, 1, -1)]
     assert np.isclose(rack[:, 1].max(), 7 * spacing) and np.isclose(rack[:, 1].mean(), 0)
     assert math.isclose(rack[:, 0].max(), 3.0 + 27 * spacing * math.sqrt(3) / 2)
+
+
+def test_random_positions_in_a_region_fill_only_that_rectangle_of_the_vessel():
+    box = Box(40, 20, partitions=[Partition("divider", (0.0, -10.0), (0.0, 10.0), gap=2.0)])
+    region = [[-20.0, -10.0], [0.0, 10.0]]
+    position = random_positions(2000, 0.1, box, np.random.default_rng(2), region=region)
+    assert (position[:, 0] <= -0.1).all() and (position[:, 0] >= -19.9).all()
+    assert (np.abs(position[:, 1]) <= 9.9).all()
+    assert (
+        min_gap(position, np.full(2000, 0.1)) >= 0
+        and not box.outside(position, np.full(2000, 0.1)).any()
+    )
+    # Uniform over the region: each half of it holds 1000 +- 3 sigma (binomial sigma ~ 22).
+    assert abs(int((position[:, 1] > 0).sum()) - 1000) < 3 * 22.4
+
+
+def test_a_region_that_leaves_no_room_is_refused_naming_it():
+    with pytest.raises(InputError) as info:
+        random_positions(10, 0.5, Box(20, 20), np.random.default_rng(0), region=[[9.8, 0], [12, 1]],
+                         field="particles.1.n")  # fmt: skip
+    assert info.value.field == "particles.1.region" and "no room" in info.value.reason

@@ -31,6 +31,7 @@ SECTIONS = {
     "heat-flow": "5",
     "granular": "5",
     "piston": "5",
+    "effusion": "5",
 }
 
 # name -> (positions, velocities, masses, charges, radius, Coulomb (k, softening) or None)
@@ -82,7 +83,7 @@ def test_default_vessel_and_run(name):
     assert scenario.run.dt == 0.01
     assert scenario.run.collisions == "exact"
     times = {"pool-break": 60.0, "heat-flow": 60.0, "brownian": 300.0, "granular": 30.0,
-             "piston": 60.0}  # fmt: skip
+             "piston": 60.0, "effusion": 200.0}  # fmt: skip
     assert scenario.run.time == times.get(name, 10.0)
     if name == "circle-gas":
         assert scenario.to_dict()["vessel"] == {"shape": "circle", "radius": 11.3}
@@ -97,9 +98,8 @@ def test_default_vessel_and_run(name):
         assert scenario.run.restitution == 0.9
         return
     assert scenario.vessel.boundary == "reflecting"
-    size = {"pool-break": (40.0, 20.0), "heat-flow": (40.0, 10.0), "piston": (20.0, 40.0)}.get(
-        name, (20.0, 20.0)
-    )
+    size = {"pool-break": (40.0, 20.0), "heat-flow": (40.0, 10.0), "piston": (20.0, 40.0),
+            "effusion": (40.0, 20.0)}.get(name, (20.0, 20.0))  # fmt: skip
     assert (scenario.vessel.width, scenario.vessel.height) == size
 
 
@@ -391,3 +391,41 @@ def test_piston_preset_compresses_to_half_when_driven():
     assert piston is not None and (piston.position, piston.velocity) == (-10.0, 0.0)
     assert piston.work == pytest.approx(sim.energy().kinetic - kinetic, rel=1e-12)
     assert piston.work > 0  # the gas was compressed: it gained energy
+
+
+def test_effusion_starts_both_masses_in_the_left_chamber_at_one_temperature():
+    sim = preset("effusion").build()
+    p = sim.particles
+    light, heavy = p.mass == 1.0, p.mass == 4.0
+    assert light.sum() == heavy.sum() == 500
+    assert (p.position[:, 0] < -0.02).all() and sim.escaped() == 0
+    # Velocity components uniform in [-s, s] and [-s/2, s/2]: kT = m s^2 / 3 for both.
+    assert np.abs(p.velocity[light]).max() == pytest.approx(5.0, abs=0.05)
+    assert np.abs(p.velocity[heavy]).max() == pytest.approx(2.5, abs=0.03)
+    ((start, end),) = sim.container.partition_lines()[:1]
+    assert sim.container.partition("divider").gap == 2.0 and start[0] == end[0] == 0.0
+
+
+def test_effusion_follows_grahams_law_and_the_lighter_escapes_faster():
+    """Graham: per-disk crossing rates in the ratio sqrt(m2/m1) = 2, within 5%; the run counts
+    some 14000 and 7000 crossings, so 5% is over 3 standard errors of the ratio. Disks of
+    radius 5 mm make the mean free path (some 14 m) long against the 4 m hole, the effusion
+    regime; steps of 0.05 s move a disk some 0.1 m, so none crosses twice between samples.
+    Each rate also matches the effusion rate <|v_x|> w / (2 A) within 3 standard errors, with
+    <|v_x|> = sqrt(2 kT / (pi m)) of the Maxwell-Boltzmann gas the collisions make in the first
+    few seconds (a mean free time is some 4 s)."""
+    sim = preset("effusion", n=2000, radius=0.005, gap=4.0, dt=0.05).build()
+    (effusion,) = sim.observers
+    kT = sim.temperature()
+    sim.run(time=20.0)
+    early = effusion.escaped[-1]
+    assert early[0] > early[1] + 0.015  # the lighter leaves its chamber faster
+    sim.run(time=580.0)
+    assert effusion.crossings.min() > 5000
+    assert effusion.ratio == pytest.approx(effusion.graham, rel=0.05)
+    assert abs(effusion.ratio - 2.0) < 3 * effusion.ratio_error
+    chamber = (20.0 - 2 * 0.005) ** 2
+    for k, mass in enumerate((1.0, 4.0)):
+        speed = math.sqrt(2 * kT / (math.pi * mass))
+        expected = theory.effusion_rate(speed, 4.0 - 2 * 0.005, chamber)
+        assert abs(effusion.rates[k] - expected) < 3 * effusion.rate_errors[k]

@@ -512,3 +512,29 @@ def test_bad_observer_tables_name_the_field(table, field):
     with pytest.raises(InputError) as caught:
         Scenario.from_toml_string(text)
     assert caught.value.field == field
+
+
+def test_a_random_group_placed_in_a_region_and_a_bad_region_named():
+    table = {"particles": [{"kind": "random", "n": 50, "region": [[2.0, -10.0], [10.0, 0.0]]}]}
+    p = Scenario.from_dict(table).build().particles
+    assert (p.position[:, 0] >= 2.25).all() and (p.position[:, 1] <= -0.25).all()
+    for region in ([[2.0, 0.0], [1.0, 3.0]], [[0.0, 0.0]], [[0.0, 0.0], [1.0, float("nan")]]):
+        with pytest.raises(InputError) as caught:
+            Scenario.from_dict({"particles": [{"kind": "random", "n": 5, "region": region}]})
+        assert caught.value.field.startswith("particles.0.region")
+
+
+def test_an_effusion_observer_must_watch_a_partition_of_the_vessel():
+    from collidium.observers import Effusion
+
+    data = {"vessel": {"partitions": [{"name": "wall", "start": [0.0, -10.0], "end": [0.0, 10.0],
+                                       "gap": 1.0}]},
+            "particles": [{"kind": "random", "n": 5, "region": [[-10.0, -10.0], [0.0, 10.0]]}],
+            "observers": [{"kind": "effusion", "partition": "wall"}]}  # fmt: skip
+    (observer,) = Scenario.from_dict(data).build().observers
+    assert isinstance(observer, Effusion) and observer.partition == "wall"
+    data["observers"] = [{"kind": "effusion", "partition": "door"}]
+    with pytest.raises(InputError) as caught:
+        Scenario.from_dict(data).build()
+    assert caught.value.field == "observers.0.partition"
+    assert caught.value.reason == "the vessel has no partition 'door' (it has: wall)"

@@ -381,6 +381,8 @@ def _print_summary(summary: dict[str, Any]) -> None:
         ("virial pressure", _number(pressure["virial"], "N/m", pressure["virial_error"])),
         ("Maxwell-Boltzmann KS p-value", _number(summary["ks_pvalue"], "")),
         ("escaped", f"{summary['escaped']}"),
+        *_piston_rows(summary.get("piston")),
+        *_effusion_rows(summary.get("observers", [])),
     ]
     table = Table(title=f"collidium run: {summary['scenario']}", show_header=False)
     table.add_column("quantity")
@@ -396,6 +398,42 @@ def _heat_rows(heat: dict[str, float]) -> list[tuple[str, str]]:
         return []
     each = ", ".join(f"{name} {value:.6g}" for name, value in heat.items() if value)
     return [("wall heat (given to the gas)", f"{each} J")]
+
+
+def _piston_rows(piston: dict[str, Any] | None) -> list[tuple[str, str]]:
+    """A row of the piston's state, when the vessel has one."""
+    if piston is None:
+        return []
+    where = f"piston ({piston['wall']})"
+    return [
+        (
+            f"{where} position, velocity",
+            f"{piston['position']:.6g} m, {piston['velocity']:.6g} m/s",
+        ),
+        (f"{where} work on the gas", f"{piston['work']:.6g} J"),
+    ]
+
+
+def _effusion_rows(observers: list[dict[str, Any]]) -> list[tuple[str, str]]:
+    """Rows of each effusion observer: per-disk crossing rates by mass, their ratio against
+    Graham's law, and the share of each species that has crossed."""
+    rows = []
+    for entry in observers:
+        if entry["observer"] != "Effusion":
+            continue
+        where = entry["partition"]
+        rows += [
+            (f"crossings of {where} per disk, {m:g} kg", _number(rate, "/s", error))
+            for m, rate, error in zip(
+                entry["masses"], entry["rates"], entry["rate_errors"], strict=True
+            )
+        ]
+        rows += [
+            ("lightest / heaviest rate", f"{_number(entry['ratio'], '', entry['ratio_error'])} "
+                                         f"(Graham: {_number(entry['graham'], '')})"),
+            (f"share across {where}", ", ".join(_number(x, "") for x in entry["escaped"])),
+        ]  # fmt: skip
+    return rows
 
 
 def _number(value: float | None, unit: str, error: float | None = None) -> str:

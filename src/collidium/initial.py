@@ -33,6 +33,7 @@ def random_positions(
     existing_radius: ArrayLike | None = None,
     field: str = "particles.n",
     max_batches: int = MAX_BATCHES,
+    region: ArrayLike | None = None,
 ) -> FloatArray:
     """Uniform random centres of ``n`` non-overlapping disks inside a vessel.
 
@@ -61,6 +62,9 @@ def random_positions(
         Field named in the error when the disks do not fit.
     max_batches : int
         Batches of candidates tried before giving up.
+    region : array_like, shape (2, 2), optional
+        Lower-left and upper-right corners (m) of a rectangle the disks must also lie in (one
+        chamber of a partitioned vessel, say); the whole vessel if None.
 
     Returns
     -------
@@ -104,8 +108,7 @@ def random_positions(
     ncy = max(1, math.ceil(height / cell))
     lo = vessel.bounds[0]
     head, next_ = _cell_lists(old, lo, cell, ncx, ncy, m + n)
-    low = lo + r_max
-    high = vessel.bounds[1] - r_max
+    low, high = _candidate_box(vessel, r_max, region, field)
     placed = m
     for _ in range(max_batches):
         batch = max(256, 2 * (m + n - placed))
@@ -123,6 +126,23 @@ def random_positions(
         f"{vessel.describe()} after {max_batches} tries; use fewer or smaller disks or a "
         "larger vessel",
     )
+
+
+def _candidate_box(
+    vessel: Vessel, r_max: float, region: ArrayLike | None, field: str
+) -> tuple[FloatArray, FloatArray]:
+    """Corners (m) of the box candidate centres are drawn in: the vessel's bounding box, cut
+    to ``region`` when given, shrunk by the largest radius."""
+    low, high = vessel.bounds[0] + r_max, vessel.bounds[1] - r_max
+    if region is None:
+        return low, high
+    corners = np.asarray(region, dtype=np.float64)
+    low, high = np.maximum(low, corners[0] + r_max), np.minimum(high, corners[1] - r_max)
+    if not (low < high).all():
+        region_field = field.rsplit(".", 1)[0] + ".region"
+        raise InputError(region_field, f"leaves no room for disks of radius {r_max:g} m in the "
+                                       f"{vessel.describe()}")  # fmt: skip
+    return low, high
 
 
 def _with_edge_images(

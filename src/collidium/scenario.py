@@ -91,6 +91,7 @@ from collidium.io.trajectory import GSDWriter
 from collidium.observers import (
     After,
     CollisionRate,
+    Effusion,
     EnergySeries,
     Every,
     Interval,
@@ -434,6 +435,17 @@ class TracerSpec(_ObserverSpec):
         return Tracer(self.particles, self.trigger())
 
 
+class EffusionSpec(_ObserverSpec):
+    """`Effusion`: crossings of the partition named ``partition`` per species, Graham's law."""
+
+    kind: Literal["effusion"] = "effusion"
+    partition: str
+
+    def build(self) -> Observer:
+        """The observer this describes."""
+        return Effusion(self.partition, self.trigger())
+
+
 class TrajectorySpec(_ObserverSpec):
     """`GSDWriter`: frames written to ``path`` (a .gsd file)."""
 
@@ -460,6 +472,7 @@ ObserverSpec = Annotated[
     | ProfileSpec
     | CollisionsSpec
     | TracerSpec
+    | EffusionSpec
     | TrajectorySpec,
     Field(discriminator="kind"),
 ]
@@ -545,7 +558,8 @@ class ExplicitGroup(_Model):
 class RandomGroup(_Model):
     """``n`` equal disks at uniform random non-overlapping positions with uniform random velocity
     components in ``[-speed, speed]``; charge ``charge`` each, or ``+charge`` / ``-charge`` in
-    equal numbers in random order with ``charges = "balanced"``."""
+    equal numbers in random order with ``charges = "balanced"``. With ``region = [[x0, y0],
+    [x1, y1]]`` the disks are placed only in that rectangle of the vessel (one chamber, say)."""
 
     model_config = ConfigDict(extra="forbid", strict=True)
 
@@ -556,6 +570,14 @@ class RandomGroup(_Model):
     speed: NonNegative = 0.0
     charge: Finite = 0.0
     charges: Literal["same", "balanced"] = "same"
+    region: Annotated[list[Vector], Field(min_length=2, max_length=2)] | None = None
+
+    @field_validator("region")
+    @classmethod
+    def _corners(cls, value: list[list[float]] | None) -> list[list[float]] | None:
+        if value is not None and not (value[0][0] < value[1][0] and value[0][1] < value[1][1]):
+            raise ValueError(f"must be [[x0, y0], [x1, y1]] with x0 < x1 and y0 < y1, got {value}")
+        return value
 
     @property
     def count(self) -> int:
@@ -569,7 +591,7 @@ class RandomGroup(_Model):
         charges from ``rng``; ``index`` is the group's place in the list, named in errors."""
         position = random_positions(
             self.n, self.radius, vessel, rng, existing=vessel.wrap(existing.position),
-            existing_radius=existing.radius, field=f"particles.{index}.n",
+            existing_radius=existing.radius, field=f"particles.{index}.n", region=self.region,
         )  # fmt: skip
         velocity = uniform_velocities(self.n, self.speed, rng)
         if self.charges == "balanced":
@@ -637,6 +659,7 @@ _TAGGED: dict[str, type[_Model]] = {
     "profile": ProfileSpec,
     "collisions": CollisionsSpec,
     "tracer": TracerSpec,
+    "effusion": EffusionSpec,
     "trajectory": TrajectorySpec,
 }
 
@@ -825,18 +848,23 @@ class Scenario(_Model):
             if exc.particles:
                 raise self._placement_error(exc.particles, vessel, particles, offsets) from None
             raise InputError(_SIMULATION_FIELDS.get(exc.field, exc.field), exc.reason) from exc
-        self._check_traced(particles.n)
+        self._check_observed(particles.n, vessel)
         sim.observers.extend(spec.build() for spec in self.observers)
         return sim
 
-    def _check_traced(self, n: int) -> None:
-        """Every particle a tracer follows exists."""
+    def _check_observed(self, n: int, vessel: Vessel) -> None:
+        """Every particle a tracer follows and every partition an observer watches exists."""
         for k, spec in enumerate(self.observers):
             for j, index in enumerate(getattr(spec, "particles", None) or []):
                 if index >= n:
                     raise InputError(
                         f"observers.{k}.particles.{j}", f"no particle {index}; there are {n}"
                     )
+            if isinstance(spec, EffusionSpec):
+                try:
+                    vessel.partition(spec.partition)
+                except InputError as exc:
+                    raise InputError(f"observers.{k}.partition", exc.reason) from None
 
     def _placement_error(
         self, culprits: tuple[int, ...], vessel: Vessel, particles: Particles, offsets: list[int]

@@ -1,6 +1,6 @@
 """Results from theory that measurements are compared with: the 2D Maxwell-Boltzmann speed
-distribution, the ideal gas and the hard-disk equation of state. Boltzmann's constant is 1
-(temperatures kT in J)."""
+distribution, the ideal gas and the hard-disk equation of state, Haff's cooling law and
+effusion. Boltzmann's constant is 1 (temperatures kT in J)."""
 
 from __future__ import annotations
 
@@ -114,3 +114,26 @@ def haff_time(density: float, diameter: float, kT: float, mass: float, restituti
 def haff_temperature(time: ArrayLike, kT: float, tau: float) -> FloatArray:
     """Haff's law ``T(t) = T0 / (1 + t / tau)^2`` (J) of a cooling granular gas."""
     return np.asarray(kT / (1.0 + np.asarray(time, dtype=float) / tau) ** 2)
+
+
+def effusion_rate(normal_speed: float, width: float, area: float) -> float:
+    """Crossings per disk per second, both ways, through a hole between two chambers of equal
+    area, narrow against the mean free path (effusion, 2D).
+
+    Disks of number density ``n`` on one side cross at ``n <v_n+> w`` per second, ``<v_n+>`` the
+    mean of the positive part of the velocity along the hole's normal, which is half the mean of
+    ``|v_n|`` for a symmetric distribution. Both ways with ``N`` disks in two chambers of area
+    ``A`` each, that is ``(N / A) <|v_n|> w / 2``, however the disks are shared: per disk
+    ``<|v_n|> w / (2 A)``. In equilibrium ``<|v_n|> = sqrt(2 kT / (pi m))``: the rate goes as
+    ``1 / sqrt(m)`` (Graham's law).
+
+    Parameters
+    ----------
+    normal_speed : float
+        Mean ``|v_n|`` over the disks, m/s.
+    width : float
+        Width of the opening open to centres, m (the hole less a diameter).
+    area : float
+        Area of one chamber open to centres, m^2.
+    """
+    return normal_speed * width / (2.0 * area)

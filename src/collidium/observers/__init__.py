@@ -8,6 +8,7 @@ accumulates, ``obs.plot(ax)`` draws it.
 
 from collidium.observers.base import After, Every, Interval, Measurement, Observer, Trigger
 from collidium.observers.counters import CollisionRate
+from collidium.observers.effusion import Effusion
 from collidium.observers.energy import EnergyDrift, EnergySeries
 from collidium.observers.paths import Tracer
 from collidium.observers.profile import TemperatureProfile
@@ -17,6 +18,7 @@ from collidium.observers.thermo import Thermo
 __all__ = [
     "After",
     "CollisionRate",
+    "Effusion",
     "EnergyDrift",
     "EnergySeries",
     "Every",

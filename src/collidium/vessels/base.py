@@ -115,6 +115,20 @@ class Vessel(ABC):
         outline, convex or not; ear clipping)."""
         return ear_clipped(self.outline())
 
+    def partition(self, name: str) -> Partition:
+        """The partition called ``name``.
+
+        Raises
+        ------
+        InputError
+            ``partition`` when there is none of that name.
+        """
+        for partition in self.partitions:
+            if partition.name == name:
+                return partition
+        names = ", ".join(p.name for p in self.partitions) or "none"
+        raise InputError("partition", f"the vessel has no partition {name!r} (it has: {names})")
+
     def partition_lines(self) -> FloatArray:
         """The partitions' pieces as drawn, ``[[start, end], ...]`` in m, shape (P, 2, 2)."""
         pieces = [partition.pieces() for partition in self.partitions]

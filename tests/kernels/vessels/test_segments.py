@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from collidium.kernels import reference
@@ -29,6 +29,10 @@ def test_element_delay_equals_its_twin_and_ends_a_radius_away(x, y, heading, spe
     start = np.array([x, y])
     if distances(start[None], TABLE[e : e + 1])[0, 0] <= r:
         return  # the disk must start clear of the segment
+    # A disk of radius 0 meets a point only on a path exactly through it: a double root of
+    # zero width, which round-off makes or breaks (the segment that ends there meets it all the
+    # same).
+    assume(not (r == 0.0 and e == 1))
     velocity = np.array([speed * math.cos(heading), speed * math.sin(heading)])
     delay = element_delay(x, y, *velocity, r, TABLE, e)
     twin = reference.segment_delay(start, velocity, r, TABLE[e])
