@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -109,6 +110,10 @@ PISTON_OUTSIDE = (
     '[vessel.walls.top]\nresponse = "piston"\nposition = 11.0\n'
     '[[particles]]\nkind = "random"\nn = 3\n'
 )
+DEEP_TABLE = "a." * 500 + "a = 1\n"
+DEEP_ARRAY = "a = " + "[" * 5000 + "]" * 5000 + "\n"
+LONG_SEED = "seed = " + "9" * 5000 + '\n[[particles]]\nkind = "random"\nn = 3\n'
+HUGE_BOX = '[vessel]\nwidth = 1e308\nheight = 1e308\n[[particles]]\nkind = "random"\nn = 3\n'
 PISTON_STEP = (
     '[vessel.walls.top]\nresponse = "piston"\nposition = 5.0\n[run]\ncollisions = "step"\n'
     '[[particles]]\nkind = "random"\nn = 3\n'
@@ -129,6 +134,17 @@ PISTON_STEP = (
         (["run", "{file}"], PISTON_OUTSIDE, "vessel.walls.top.position"),
         (["run", "{file}"], PISTON_STEP, "run.collisions"),
         (["run", "piston", "--set", "force=-1"], None, "force"),
+        (["run", "{file}"], DEEP_TABLE, "a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a"),
+        (["run", "{file}"], DEEP_ARRAY, "{file}"),
+        (["run", "{file}"], LONG_SEED, "{file}"),
+        (["run", "{file}"], HUGE_BOX, "vessel.width"),
+        (["run", "gas", "--set", "vessel." + "a." * 600 + "a=1"], None, "vessel" + ".a" * 16),
+        (["run", "gas", "--set", "n=" + "9" * 5000], None, "n"),
+        (["run", "gas", "--set", "x=" + "[" * 3000 + "]" * 3000], None, "x"),
+        (["run", "gas", "--set", "width=1e308", "--set", "height=1e308"], None, "vessel.width"),
+        (["run", "gas", "--set", "speed=1e308"], None, "particles.velocity"),
+        (["run", "/dev/zero"], None, "/dev/zero"),
+        (["run", "gas", "--set", "name=0"], None, "name"),  # not the preset's own name
         (["run", "effusion", "--set", "gap=30"], None, "vessel.partitions.divider.gap"),
         (["run", "head-on", "--dt", "0"], None, "dt"),
         (["run", "head-on", "--dt", "nan"], None, "dt"),
@@ -179,6 +195,13 @@ def test_bad_input_gives_one_line_and_exit_2(tmp_path, args, toml, field):
     assert result.stdout == ""
     # Nothing half-written: the folder holds at most the scenario file the test wrote.
     assert {p.name for p in tmp_path.iterdir()} <= {"scenario.toml"}
+
+
+def test_a_pipe_is_refused_at_once_rather_than_read_forever(tmp_path):
+    pipe = tmp_path / "scenario.toml"
+    os.mkfifo(pipe)
+    result = collidium("run", pipe)
+    assert result.returncode == 2 and result.stderr == f"error: {pipe}: not a regular file\n"
 
 
 def test_bad_toml_error_names_the_line(tmp_path):

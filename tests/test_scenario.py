@@ -538,3 +538,17 @@ def test_an_effusion_observer_must_watch_a_partition_of_the_vessel():
         Scenario.from_dict(data).build()
     assert caught.value.field == "observers.0.partition"
     assert caught.value.reason == "the vessel has no partition 'door' (it has: wall)"
+
+
+def test_particles_beyond_the_memory_available_are_refused_before_any_allocation(monkeypatch):
+    from collidium import scenario
+
+    monkeypatch.setattr(scenario, "available_memory", lambda: 2**30)
+    huge = Scenario.from_dict({"particles": [{"kind": "rack", "rows": 10_000}]})
+    with pytest.raises(InputError) as caught:
+        huge.build()
+    assert caught.value.field == "particles"
+    assert caught.value.reason == (
+        "99999999 particles need about 37.3 GiB of memory; 1 GiB is available"
+    )
+    Scenario.from_dict({"particles": [{"kind": "random", "n": 1000}]}).build()  # 0.4 MB: fine

@@ -342,6 +342,10 @@ def parse_settings(items: Sequence[str]) -> dict[str, Any]:
             values[key] = tomllib.loads(f"value = {text}")["value"]
         except tomllib.TOMLDecodeError:
             values[key] = text
+        except ValueError:  # Python refuses to read an integer of over 4300 digits
+            raise InputError(key, "a number with too many digits") from None
+        except RecursionError:
+            raise InputError(key, "arrays or tables nested too deeply") from None
     return values
 
 

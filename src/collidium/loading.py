@@ -16,7 +16,7 @@ if TYPE_CHECKING:
 FILE_ALIASES = {"dt": "run.dt", "time": "run.time", "collisions": "run.collisions", "seed": "seed"}
 
 
-def load_scenario(source: str | Path, **overrides: Any) -> Scenario:
+def load_scenario(source: str | Path, /, **overrides: Any) -> Scenario:
     """The scenario of a preset or a TOML file, with overrides applied and validated.
 
     Parameters
@@ -52,7 +52,7 @@ def load_scenario(source: str | Path, **overrides: Any) -> Scenario:
     return scenario.with_overrides(dotted) if dotted else scenario
 
 
-def load(source: str | Path, **overrides: Any) -> Simulation:
+def load(source: str | Path, /, **overrides: Any) -> Simulation:
     """A `Simulation` built from a preset name or a TOML scenario file, with overrides.
 
     Examples

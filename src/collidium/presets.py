@@ -479,7 +479,7 @@ def parameters(name: str) -> dict[str, Any]:
     return dict(_entry(name).parameters)
 
 
-def preset(name: str, **overrides: Any) -> Scenario:
+def preset(name: str, /, **overrides: Any) -> Scenario:
     """The scenario of a preset, with keyword overrides.
 
     Parameters

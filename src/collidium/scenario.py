@@ -63,6 +63,8 @@ from __future__ import annotations
 
 import copy
 import math
+import os
+import stat
 import tomllib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -803,7 +805,13 @@ class Scenario(_Model):
             All groups concatenated in order.
         offsets : list of int
             Index of the first particle of each group, then the total N (length groups + 1).
+
+        Raises
+        ------
+        InputError
+            ``particles`` when the simulation would not fit in the memory available.
         """
+        _check_memory(self.particle_count)
         vessel = self.vessel.build()
         rng = np.random.default_rng(self.seed)
         fixed = {
@@ -926,17 +934,64 @@ def _local(field: str, label: str) -> str:
 # --- plain data, TOML ---------------------------------------------------------------------------
 
 
-def plain(value: Any) -> Any:
-    """Deep copy of ``value`` with numpy scalars and arrays and tuples made plain Python."""
+#: Deepest nesting of tables and arrays a scenario may have (its own go 4 deep).
+MAX_DEPTH = 16
+
+
+def plain(value: Any, path: tuple[str, ...] = ()) -> Any:
+    """Deep copy of ``value`` with numpy scalars and arrays and tuples made plain Python.
+
+    Raises
+    ------
+    InputError
+        Naming the path where tables or arrays nest more than `MAX_DEPTH` deep.
+    """
+    if len(path) > MAX_DEPTH:
+        raise InputError(".".join(path[: MAX_DEPTH + 1]),
+                         f"tables or arrays nested more than {MAX_DEPTH} deep")  # fmt: skip
     if isinstance(value, Mapping):
-        return {key: plain(item) for key, item in value.items()}
+        return {key: plain(item, (*path, str(key))) for key, item in value.items()}
     if isinstance(value, np.ndarray):
-        return plain(value.tolist())
+        return plain(value.tolist(), path)
     if isinstance(value, list | tuple):
-        return [plain(item) for item in value]
+        return [plain(item, (*path, str(k))) for k, item in enumerate(value)]
     if isinstance(value, np.generic):
         return value.item()
     return copy.copy(value)
+
+
+#: Memory one particle takes at the peak of building and running a simulation, bytes: about 220
+#: for a million-disk gas in the exact engine, with a margin.
+BYTES_PER_PARTICLE = 400
+
+
+def _check_memory(count: int) -> None:
+    """Refuse, before allocating anything, particles that would not fit in the memory
+    available."""
+    need, have = count * BYTES_PER_PARTICLE, available_memory()
+    if have is not None and need > have:
+        raise InputError("particles", f"{count} particles need about {need / 2**30:.3g} GiB of "
+                                      f"memory; {have / 2**30:.3g} GiB is available")  # fmt: skip
+
+
+def available_memory() -> int | None:
+    """Bytes of memory available to a new allocation (Linux ``MemAvailable``, else the physical
+    memory), or None where neither is known."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as info:
+            for line in info:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+#: Largest scenario file read, bytes (a listing of a million explicit disks is about 60 MB).
+MAX_SCENARIO_BYTES = 256 * 2**20
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:
@@ -945,10 +1000,16 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     Raises
     ------
     InputError
-        Naming the file, for a missing or unreadable file or bad syntax (with line and column).
+        Naming the file, for a missing or unreadable file, one that is not a regular file (a
+        folder, a pipe, a device) or is over `MAX_SCENARIO_BYTES`, or bad syntax (with line and
+        column).
     """
     name = str(path)
     try:
+        if not stat.S_ISREG(Path(path).stat().st_mode):
+            raise InputError(name, "not a regular file")
+        if Path(path).stat().st_size > MAX_SCENARIO_BYTES:
+            raise InputError(name, f"larger than {MAX_SCENARIO_BYTES // 2**20} MiB")
         text = Path(path).read_bytes().decode("utf-8")
     except FileNotFoundError:
         raise InputError(name, "no such file") from None
@@ -965,6 +1026,8 @@ def parse_toml(text: str, source: str) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(source, f"invalid TOML: {exc}") from None
+    except ValueError:  # Python refuses to read an integer of over 4300 digits
+        raise InputError(source, "invalid TOML: a number with too many digits") from None
     except RecursionError:
         raise InputError(source, "invalid TOML: arrays or tables nested too deeply") from None
 

@@ -596,7 +596,19 @@ def _check_setup(
     _check_dt(dt)
     _check_mode(collisions, container)
     container.check_fits(particles.radius)
+    _check_kinetic_energy(particles)
     return container
+
+
+def _check_kinetic_energy(particles: Particles) -> None:
+    """Refuse speeds whose kinetic energy is beyond float64 (every later sum would overflow)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        energy = particles.mass * np.einsum("ij,ij->i", particles.velocity, particles.velocity)
+        total = float(np.sum(energy))
+    if not math.isfinite(total):
+        fastest = float(np.abs(particles.velocity).max(initial=0.0))
+        raise InputError("particles.velocity", f"the kinetic energy overflows float64 (a velocity "
+                                               f"component of {fastest:.3g} m/s)")  # fmt: skip
 
 
 def _check_forces(forces: Sequence[Coulomb], container: Vessel) -> None:

@@ -42,6 +42,8 @@ def test_disks_too_large_for_the_box_are_refused():
     [
         ((0, 10), "vessel.width"),
         ((10, -1), "vessel.height"),
+        ((1e308, 1e308), "vessel.width"),  # its area and cell counts would overflow
+        ((10, 2e12), "vessel.height"),
         ((10, 10, "sticky"), "vessel.boundary"),
     ],
 )

@@ -43,7 +43,7 @@ def test_a_circle_answers_the_geometry_every_layer_asks_for():
     assert vessel_from_dict(circle.to_dict()).to_dict() == {"shape": "circle", "radius": 10.0}
 
 
-@pytest.mark.parametrize("radius", [0.0, -1.0, math.nan, math.inf])
+@pytest.mark.parametrize("radius", [0.0, -1.0, math.nan, math.inf, 2e12])
 def test_a_bad_radius_names_the_field(radius):
     with pytest.raises(InputError, match=r"vessel\.radius: must be a finite number > 0"):
         Circle(radius)

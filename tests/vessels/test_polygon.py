@@ -81,6 +81,7 @@ def test_a_regular_polygon_leaves_a_similar_one_to_the_centres(corners):
         ([[0, 0], [4, 0]], "must be at least 3 [x, y] points"),
         ([[0, 0], [4, 0], [4, 0], [0, 4]], "has two equal consecutive points"),
         ([[0, 0], [4, 0], [math.nan, 4]], "must be finite numbers"),
+        ([[0, 0], [2e12, 0], [0, 1]], "must span at most 1e+12 m"),
         ("square", "must be"),
     ],
 )

@@ -26,6 +26,20 @@ from collidium.vessels.walls import (
 #: Relative round-off allowance when deciding that a disk pokes out of a vessel.
 OUTSIDE_TOLERANCE = 1e-9
 
+#: Largest extent of a vessel, m: float64 positions still resolve 0.1 mm across it, and its
+#: area and cell counts stay far from overflowing.
+MAX_EXTENT = 1e12
+
+
+def check_extent(value: float, field: str) -> float:
+    """``value`` (m) as a float, or `InputError` naming ``field`` unless finite, > 0 and at most
+    `MAX_EXTENT`."""
+    if not (isinstance(value, int | float | np.floating | np.integer) and math.isfinite(value)
+            and 0 < value <= MAX_EXTENT):  # fmt: skip
+        raise InputError(field, f"must be a finite number > 0 and at most {MAX_EXTENT:g} m, got "
+                                f"{value!r}")  # fmt: skip
+    return float(value)
+
 
 class Vessel(ABC):
     """A 2D container of disks, with named walls.

@@ -15,7 +15,7 @@ from collidium.errors import InputError
 from collidium.kernels.vessels import BOX
 from collidium.kernels.vessels import box as box_walls
 from collidium.state import BoolArray, FloatArray, IntArray
-from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
+from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel, check_extent
 from collidium.vessels.partitions import Partition
 from collidium.vessels.walls import Piston, WallResponse, piston_array
 
@@ -59,13 +59,10 @@ class Box(Vessel):
         walls: dict[str, WallResponse] | None = None,
         partitions: tuple[Partition, ...] | list[Partition] = (),
     ) -> None:
-        for name, value in (("width", width), ("height", height)):
-            if not np.isfinite(value) or value <= 0:
-                raise InputError(f"vessel.{name}", f"must be a finite number > 0, got {value!r}")
+        self.width = check_extent(width, "vessel.width")
+        self.height = check_extent(height, "vessel.height")
         if boundary not in BOUNDARIES:
             raise InputError("vessel.boundary", f"must be one of {BOUNDARIES}, got {boundary!r}")
-        self.width = float(width)
-        self.height = float(height)
         self.boundary: Boundary = boundary
         super().__init__(walls, partitions)
 

@@ -16,7 +16,7 @@ import numpy as np
 from collidium.errors import InputError
 from collidium.kernels.vessels import CIRCLE
 from collidium.state import BoolArray, FloatArray
-from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel
+from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel, check_extent
 from collidium.vessels.partitions import Partition
 from collidium.vessels.walls import WallResponse
 
@@ -47,9 +47,7 @@ class Circle(Vessel):
         walls: dict[str, WallResponse] | None = None,
         partitions: tuple[Partition, ...] | list[Partition] = (),
     ) -> None:
-        if not (isinstance(radius, int | float) and math.isfinite(radius) and radius > 0):
-            raise InputError("vessel.radius", f"must be a finite number > 0, got {radius!r}")
-        self.radius = float(radius)
+        self.radius = check_extent(radius, "vessel.radius")
         super().__init__(walls, partitions)
 
     @property

@@ -15,7 +15,7 @@ import numpy as np
 from collidium.errors import InputError
 from collidium.kernels.vessels import POLYGON
 from collidium.state import BoolArray, FloatArray
-from collidium.vessels.base import Vessel
+from collidium.vessels.base import MAX_EXTENT, Vessel
 from collidium.vessels.partitions import Partition, distances, segment_table
 from collidium.vessels.walls import WallResponse
 
@@ -186,6 +186,8 @@ def _checked_vertices(vertices: Any) -> FloatArray:
         raise InputError(field, f"must be at least 3 [x, y] points, got {vertices!r}")
     if not np.isfinite(points).all():
         raise InputError(field, "must be finite numbers")
+    if np.ptp(points, axis=0).max() > MAX_EXTENT:
+        raise InputError(field, f"must span at most {MAX_EXTENT:g} m")
     following = np.roll(points, -1, axis=0)
     if (points == following).all(axis=1).any():
         raise InputError(field, "has two equal consecutive points")
