@@ -1006,9 +1006,10 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     """
     name = str(path)
     try:
-        if not stat.S_ISREG(Path(path).stat().st_mode):
+        status = Path(path).stat()
+        if not stat.S_ISREG(status.st_mode):
             raise InputError(name, "not a regular file")
-        if Path(path).stat().st_size > MAX_SCENARIO_BYTES:
+        if status.st_size > MAX_SCENARIO_BYTES:
             raise InputError(name, f"larger than {MAX_SCENARIO_BYTES // 2**20} MiB")
         text = Path(path).read_bytes().decode("utf-8")
     except FileNotFoundError:

@@ -70,7 +70,7 @@ class Effusion(Measurement):
         )
         self._crossings = np.zeros(self.masses.size, dtype=np.int64)
         self._position = sim.particles.position.copy()
-        self._first_side = self._side(self._position)
+        self._first_side = self._last_side = self._side(self._position)
         self._time, self._escaped = [], []
 
     def _side(self, position: FloatArray) -> np.ndarray:
@@ -79,7 +79,7 @@ class Effusion(Measurement):
     def _sample(self, sim: Simulation) -> None:
         before, now = self._position, sim.particles.position
         side = self._side(now)
-        moved = np.flatnonzero(side != self._side(before))
+        moved = np.flatnonzero(side != self._last_side)
         if moved.size:
             d0 = (before[moved] - self._a) @ self._normal
             d1 = (now[moved] - self._a) @ self._normal
@@ -87,7 +87,7 @@ class Effusion(Measurement):
             within = np.abs((meet - self._a) @ self._along - 0.5) <= 0.5
             self._crossings += np.bincount(self._species[moved[within]],
                                            minlength=self.masses.size)  # fmt: skip
-        self._position = now.copy()
+        self._position, self._last_side = now.copy(), side
         self._time.append(sim.time)
         away = np.bincount(self._species, weights=side != self._first_side,
                            minlength=self.masses.size)  # fmt: skip
