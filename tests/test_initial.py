@@ -7,9 +7,11 @@ import math
 import numpy as np
 import pytest
 
+from collidium import initial
 from collidium.errors import InputError
 from collidium.initial import (
     balanced_charges,
+    hexagonal_positions,
     random_positions,
     rhombus_rack,
     uniform_velocities,
@@ -143,3 +145,31 @@ def test_a_region_that_leaves_no_room_is_refused_naming_it():
         random_positions(10, 0.5, Box(20, 20), np.random.default_rng(0), region=[[9.8, 0], [12, 1]],
                          field="particles.1.n")  # fmt: skip
     assert info.value.field == "particles.1.region" and "no room" in info.value.reason
+
+
+def test_placement_grid_covers_the_region_not_the_vessel(rng):
+    """Disks placed in a 10 m corner of a 10 km box are looked up in cells over that corner
+    (over the whole box they would all share a few cells, and placement would be quadratic)."""
+    vessel = Box(1e4, 1e4)
+    region = [[-5e3, -5e3], [-4990.0, -4990.0]]
+    position = random_positions(2000, 0.05, vessel, rng, region=region)
+    assert (position >= -5e3 + 0.05).all() and (position <= -4990.0 - 0.05).all()
+    low, high = initial._candidate_box(vessel, 0.05, region, "particles.n")
+    corner, cell, ncx, ncy = initial._placement_grid(np.zeros((0, 2)), low, high, 0.05, 2000)
+    np.testing.assert_array_equal(corner, low)
+    assert 0.1 <= cell <= 0.3 and ncx * ncy >= 1000
+
+
+@pytest.mark.parametrize("packing", [0.3, 0.7, 0.9])
+def test_hexagonal_positions_pack_the_plane_as_asked(packing):
+    """Nearest neighbours one lattice spacing apart, so the disks cover ``packing`` of the
+    plane (a hexagonal cell of area sqrt(3)/2 a^2 per disk), none overlapping, all inside."""
+    vessel, radius = Box(20.0, 20.0), 0.25
+    position = hexagonal_positions(vessel, radius, packing)
+    spacing = radius * math.sqrt(2 * math.pi / (math.sqrt(3) * packing))
+    gaps = np.linalg.norm(position[:, None] - position[None, :], axis=2)
+    np.fill_diagonal(gaps, np.inf)
+    np.testing.assert_allclose(gaps.min(axis=1), spacing, rtol=1e-12)
+    assert math.pi * radius**2 / (math.sqrt(3) / 2 * spacing**2) == pytest.approx(packing)
+    assert vessel.outside(position, np.full(len(position), radius)).size == 0
+    assert len(position) > 0.8 * packing * 400 / (math.pi * radius**2)

@@ -26,7 +26,10 @@ class OverlapWatch:
     def update(self, sim: cd.Simulation) -> None:
         p, box = sim.particles, sim.container
         shape = grid_shape(box.width, box.height, 2 * p.radius.max(), p.n)
-        pair = first_overlap(p.position, p.radius, box.width, box.height, box.periodic, *shape)
+        window = np.array([[-box.width, -box.height], [box.width, box.height]]) / 2
+        pair = first_overlap(
+            p.position, p.radius, box.width, box.height, box.periodic, window, *shape
+        )
         if pair != (-1, -1) and self.first_pair == (-1, -1):
             self.first_pair = pair
         self.reports += 1

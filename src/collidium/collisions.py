@@ -23,7 +23,7 @@ import numpy as np
 
 from collidium.errors import SimulationError
 from collidium.kernels import events, stepper
-from collidium.kernels.cells import event_grid_shape
+from collidium.kernels.cells import bounding_box, event_grid_shape, grid_window, window_sides
 from collidium.kernels.vessels import piston as piston_kernels
 from collidium.state import FloatArray, IntArray, Particles, as_given
 from collidium.vessels import Vessel
@@ -227,6 +227,8 @@ class StepCollisions(_Stateless):
     def __init__(self, restitution: float = 1.0) -> None:
         self.restitution = restitution
         self._layout: tuple[int, float, float, bool] | None = None
+        self._window = np.zeros((2, 2))  # the rectangle the cells cover (`grid_window`)
+        self._whole = True  # whether that is the vessel's whole bounding box
         self._diameter = 0.0
         self._sorted = False  # whether the cell order of the step before is at hand
         self._radius = np.empty(0)  # the radii seen at the step before
@@ -239,7 +241,10 @@ class StepCollisions(_Stateless):
         self._layout = (n, width, height, vessel.periodic)
         self._diameter = diameter
         self._sorted = False
-        ncx, ncy, self._general = stepper.step_grid(width, height, diameter, n, vessel.periodic)
+        self._window = grid_window(particles.position, diameter, vessel.extent, vessel.periodic)
+        self._whole = _covers(self._window, vessel.extent)
+        sides = window_sides(self._window)
+        ncx, ncy, self._general = stepper.step_grid(*sides, diameter, n, vessel.periodic)
         self._shape = (ncx, ncy)
         self._chunks = min(self.SEARCH_CHUNKS, ncy)
         index = np.int32 if max(n, ncx * ncy) < 2**31 - 1 else np.int64
@@ -259,10 +264,9 @@ class StepCollisions(_Stateless):
 
     def _sort(self, particles: Particles, vessel: Vessel, fresh: bool, uniform: bool) -> None:
         """Sort the particles into cells (from last step's order when there is one)."""
-        width, height = (float(side) for side in vessel.extent)
         if self._sorted:
             self._sorted = stepper.update_cells(
-                particles.position, particles.radius, fresh, uniform, width, height,
+                particles.position, particles.radius, fresh, uniform, self._window,
                 *self._shape, self._order, self._key, self._data_xy, self._data_r,
                 self._new_key, self._movers, self._grouped, self._moved, self._order_out,
                 self._key_out, self._start, self._cell_xy, self._cell_r,
@@ -272,7 +276,7 @@ class StepCollisions(_Stateless):
                 self._key, self._key_out = self._key_out, self._key
                 return
         stepper.sort_into_cells(
-            particles.position, particles.radius, uniform, width, height, *self._shape,
+            particles.position, particles.radius, uniform, self._window, *self._shape,
             self._movers, self._data_xy, self._data_r, self._cursor, self._order, self._key,
             self._start, self._cell_xy, self._cell_r,
         )  # fmt: skip
@@ -307,8 +311,13 @@ class StepCollisions(_Stateless):
         changed, uniform, largest = self._radius_summary(particles.radius)
         width, height = (float(side) for side in vessel.extent)
         layout = (particles.n, width, height, vessel.periodic)
-        # Cells must stay at least a diameter wide; they are kept if the disks shrink.
-        if layout != self._layout or 2.0 * largest > self._diameter:
+        # Cells must stay at least a diameter wide; they are kept if the disks shrink. A window
+        # short of the vessel is made again once disks have left it.
+        if (
+            layout != self._layout
+            or 2.0 * largest > self._diameter
+            or not (self._whole or _inside(particles.position, self._window))
+        ):
             self._make_grid(particles, vessel, 2.0 * largest)
             changed = True
         if uniform and changed:  # equal radii: the same in every order, left alone by the sort
@@ -401,7 +410,8 @@ class ExactCollisions:
     ) -> dict[str, np.ndarray]:
         n = particles.n
         diameter = 2.0 * float(particles.radius.max(initial=0.0))
-        width, height = (float(side) for side in vessel.extent)
+        window = grid_window(particles.position, diameter, vessel.extent, vessel.periodic)
+        width, height = window_sides(window)
         ncx, ncy = event_grid_shape(width, height, diameter, n)
         shared = _shared_radius_and_mass(particles)
         columns = events.BODY_COLUMNS if shared is None else events.SHARED_BODY_COLUMNS
@@ -413,9 +423,10 @@ class ExactCollisions:
             s = old
         else:
             s = _engine_arrays(n, ncx * ncy, columns)
+        half_width, half_height = (0.5 * float(side) for side in vessel.extent)
         s["geometry"] = np.array(
-            [0.5 * width, 0.5 * height, width / ncx, height / ncy, *(shared or (np.nan, np.nan)),
-             vessel.shape_code, vessel.rim, self.restitution, ELASTIC_BELOW]
+            [half_width, half_height, width / ncx, height / ncy, *(shared or (np.nan, np.nan)),
+             vessel.shape_code, vessel.rim, self.restitution, ELASTIC_BELOW, *window[0]]
         )  # fmt: skip
         s["grid"] = np.array([ncx, ncy, int(vessel.periodic)], dtype=np.int64)
         events.load(
@@ -476,10 +487,41 @@ class ExactCollisions:
                 int(halt[events.HALT_PARTICLE]),
                 int(halt[events.HALT_PARTNER]),
             )
-        events.synchronise(until, s["body"], s["ident"], particles.position, particles.velocity)
+        strays = events.synchronise(
+            until, s["body"], s["ident"], s["geometry"], s["grid"], particles.position,
+            particles.velocity,
+        )  # fmt: skip
         tally.piston[...] = _piston_now(s["piston"], until)
         self._synced_at = until
+        if strays and s["grid"][2] == 0 and not _window_is_vessel(s["geometry"], s["grid"]):
+            # Disks have spread out of the cells' window: a larger one at the next drift.
+            self._spare, self._state = self._state, None
         return None
+
+
+def _window_is_vessel(geometry: FloatArray, grid: np.ndarray) -> bool:
+    """Whether the engine's cells cover the vessel's whole bounding box."""
+    g = events
+    low = geometry[[g.GRID_LEFT, g.GRID_BOTTOM]]
+    high = low + grid[:2] * geometry[[g.CELL_WIDTH, g.CELL_HEIGHT]]
+    return _covers(np.array([low, high]), 2.0 * geometry[[g.HALF_WIDTH, g.HALF_HEIGHT]])
+
+
+def _covers(window: FloatArray, extent: tuple[float, float] | FloatArray) -> bool:
+    """Whether a cells' window ``[[x0, y0], [x1, y1]]`` (m) covers a vessel's bounding box of
+    sides ``extent`` (m), centred on the origin."""
+    half = 0.5 * np.asarray(extent, dtype=np.float64)
+    return bool((window[0] <= -half).all() and (window[1] >= half).all())
+
+
+def _inside(position: FloatArray, window: FloatArray) -> bool:
+    """Whether every point of ``position`` (N, 2) lies in ``window`` (m)."""
+    if position.shape[0] == 0:
+        return True
+    x0, y0, x1, y1 = bounding_box(position)
+    return bool(
+        window[0, 0] <= x0 and window[0, 1] <= y0 and x1 <= window[1, 0] and y1 <= window[1, 1]
+    )
 
 
 def _piston_now(piston: FloatArray, t: float) -> FloatArray:
@@ -559,9 +601,9 @@ def _restored(saved: dict[str, np.ndarray]) -> dict[str, np.ndarray] | None:
 
 
 #: The layout of the engine's saved queues (2: walls after the cell crossings, any number of
-#: them; 3: the pairs' restitution in ``geometry``); a queue saved with another is rebuilt, not
-#: read.
-_EVENT_CODES = 3
+#: them; 3: the pairs' restitution in ``geometry``; 4: the cells' window there too); a queue saved
+#: with another is rebuilt, not read.
+_EVENT_CODES = 4
 
 
 #: The engine's arrays that are views of columns of ``event`` (`_engine_arrays`).

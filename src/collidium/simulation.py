@@ -35,7 +35,7 @@ from collidium.integrators import (
 )
 from collidium.io.checkpoint import read_checkpoint, saved_vessel, write_checkpoint
 from collidium.kernels.audit import first_invalid
-from collidium.kernels.cells import first_overlap, grid_shape
+from collidium.kernels.cells import first_overlap, grid_shape, grid_window, window_sides
 from collidium.observers.base import Observer
 from collidium.state import PROPERTIES, FloatArray, Particles, as_given
 from collidium.vessels import OUTSIDE_TOLERANCE, Vessel, vessel_from_dict
@@ -668,9 +668,10 @@ def _check_placement(container: Vessel, particles: Particles, collisions: str) -
         return  # pass-through disks may overlap
     width, height = (float(side) for side in container.size)
     diameter = 2.0 * float(particles.radius.max(initial=0.0))
-    ncx, ncy = grid_shape(width, height, diameter, particles.n)
+    window = grid_window(particles.position, diameter, (width, height), container.periodic)
+    ncx, ncy = grid_shape(*window_sides(window), diameter, particles.n)
     i, j = first_overlap(
-        particles.position, particles.radius, width, height, container.periodic, ncx, ncy
+        particles.position, particles.radius, width, height, container.periodic, window, ncx, ncy
     )
     if i >= 0:
         detail = overlap_detail(container, particles, i, j)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from collidium import Box, Circle, Particles, Simulation, collisions
-from collidium.kernels import events, reference
+from collidium.kernels import cells, events, reference
 from collidium.kernels.events import contact_delay
 from conftest import jittered_lattice
 
@@ -91,6 +91,44 @@ def test_engine_matches_brute_force_twin_in_a_circle(rng):
     np.testing.assert_allclose(sim.tally.impulse[:2], [virial, *wall_impulse], rtol=1e-9)
     np.testing.assert_allclose(sim.particles.position, twin_position, rtol=0, atol=1e-9 * rim)
     np.testing.assert_allclose(sim.particles.velocity, twin_velocity, rtol=0, atol=1e-8 * 10)
+
+
+def test_cluster_spreading_in_a_large_box_matches_the_twin(rng, monkeypatch):
+    """Disks packed in a corner of a large box: the engine's cells cover only the disks'
+    surroundings (`cells.grid_window`, here for any number of disks), and a new window is made
+    each time they spread out of it. Same collisions and final state as the all-pairs twin."""
+    monkeypatch.setattr(cells, "WINDOW_FROM", 1)
+    width = 60.0
+    position = jittered_lattice(7, 6.0, 0.04, rng) - 26.0  # about the corner (-26, -26)
+    n = len(position)
+    velocity = rng.uniform(-10, 10, (n, 2))
+    mass = rng.uniform(0.5, 2.0, n)
+    radius = rng.uniform(0.02, 0.04, n)
+    sim = Simulation(
+        Box(width, width),
+        Particles(position.copy(), velocity.copy(), mass=mass, radius=radius),
+        dt=0.1,
+    )
+    state = sim._drift._rebuild(sim.particles, sim.container, 0.0, sim.tally.piston)
+    assert state["head"].size * 20 < (width / 0.08) ** 2  # not a grid of the whole box
+    sim.run(steps=6)
+    assert sim._drift.rebuilds >= 3  # the window was made again as the disks spread
+    twins = []
+    for nudge in (0.0, 1e-15):  # the twin again from velocities 1e-15 apart: round-off's growth
+        twin_position, twin_velocity = position.copy(), velocity * (1.0 + nudge)
+        pairs, walls, *_ = reference.event_drift(
+            twin_position, twin_velocity, mass, radius, np.array([width, width]) / 2, 0.6
+        )
+        twins.append((twin_position, twin_velocity))
+    assert pairs > 10 and walls > 5
+    assert (sim.counters.pair_collisions, sim.counters.wall_collisions) == (pairs, walls)
+    (twin_position, twin_velocity), (nudged_position, nudged_velocity) = twins
+    # A cluster amplifies round-off more than a spread gas: the engine (whose operations differ
+    # from the twin's in round-off) agrees with it about as well as the nudged twin does.
+    growth = max(np.abs(nudged_position - twin_position).max(), 1e-12)
+    assert np.abs(sim.particles.position - twin_position).max() < 100 * growth
+    growth = max(np.abs(nudged_velocity - twin_velocity).max(), 1e-12)
+    assert np.abs(sim.particles.velocity - twin_velocity).max() < 100 * growth
 
 
 def _dense_gas(boundary: str, rng: np.random.Generator) -> Simulation:

@@ -37,25 +37,52 @@ def test_overlapping_pairs_resolved_like_the_twin(rng):
     np.testing.assert_allclose(tally.impulse[0], want_virial, rtol=1e-12)
 
 
+BOX_WINDOW = np.array([[-5.0, -5.0], [5.0, 5.0]])
+
+
 def test_first_overlap_equals_twin(rng):
     position, radius = _crowd(rng)
     ncx, ncy = grid_shape(10.0, 10.0, 2 * radius.max(), len(radius))
-    assert first_overlap(position, radius, 10.0, 10.0, False, ncx, ncy) == (
+    assert first_overlap(position, radius, 10.0, 10.0, False, BOX_WINDOW, ncx, ncy) == (
         reference.first_overlap(position, radius)
     )
     apart = np.array([[-1.0, 0.0], [1.0, 0.0]])
-    assert first_overlap(apart, np.array([0.5, 0.5]), 10.0, 10.0, False, 1, 1) == (-1, -1)
+    assert first_overlap(apart, np.array([0.5, 0.5]), 10.0, 10.0, False, BOX_WINDOW, 1, 1) == (
+        -1,
+        -1,
+    )
+
+
+@pytest.mark.parametrize("scale", [0.05, 0.3])
+def test_first_overlap_on_a_window_smaller_than_the_disks_spread_equals_twin(rng, scale):
+    """Disks outside the grid's window fall in its edge cells (clamped): overlaps there are
+    still all found."""
+    position, radius = _crowd(rng)
+    ncx, ncy = grid_shape(10.0 * scale, 10.0 * scale, 2 * radius.max(), len(radius))
+    window = BOX_WINDOW * scale
+    want = reference.first_overlap(position, radius)
+    assert want != (-1, -1)
+    assert first_overlap(position, radius, 10.0, 10.0, False, window, ncx, ncy) == want
+    apart = position[[0, 1, 2]] * [[1.0, 1.0], [1.0, 1.0], [1.0, 1.0]]
+    assert reference.first_overlap(apart, radius[:3]) == (-1, -1)
+    assert first_overlap(apart, radius[:3], 10.0, 10.0, False, window, ncx, ncy) == (-1, -1)
 
 
 def test_periodic_overlap_across_the_edge_is_found():
     position = np.array([[-4.9, 0.0], [4.9, 0.0], [0.0, 0.0]])
     radius = np.full(3, 0.25)
     for ncx in (1, 2, 3, 20):
-        assert first_overlap(position, radius, 10.0, 10.0, True, ncx, ncx) == (0, 1)
+        assert first_overlap(position, radius, 10.0, 10.0, True, BOX_WINDOW, ncx, ncx) == (0, 1)
 
 
-def _sorted(position, radius, width, height, ncx, ncy, index=np.int32):
-    """The particles sorted into cells by `stepper.sort_into_cells`."""
+def _window(width, height, scale=1.0):
+    """The window of a box's cells (a share ``scale`` of the box, centred)."""
+    return np.array([[-width, -height], [width, height]]) * (0.5 * scale)
+
+
+def _sorted(position, radius, width, height, ncx, ncy, index=np.int32, scale=1.0):
+    """The particles sorted into cells by `stepper.sort_into_cells` (cells over a share
+    ``scale`` of the box)."""
     n = len(position)
     out = {
         "order": np.empty(n, index),
@@ -65,7 +92,8 @@ def _sorted(position, radius, width, height, ncx, ncy, index=np.int32):
         "r": np.empty(n),
     }
     stepper.sort_into_cells(
-        position, radius, False, width, height, ncx, ncy, np.empty(n, index), np.empty((n, 2)),
+        position, radius, False, _window(width, height, scale), ncx, ncy, np.empty(n, index),
+        np.empty((n, 2)),
         np.empty(n), np.empty(ncx * ncy, index), out["order"], out["key"], out["start"],
         out["xy"], out["r"],
     )  # fmt: skip
@@ -79,6 +107,7 @@ def _cell_of(position, width, height, ncx, ncy):
 
 
 def _check_sorted(cells, position, radius, width, height, ncx, ncy):
+    """``width`` and ``height``: the sides of the cells' window, centred on the origin."""
     order, key, start = cells["order"], cells["key"], cells["start"]
     n = len(position)
     np.testing.assert_array_equal(np.sort(order), np.arange(n))
@@ -102,7 +131,7 @@ def test_cells_are_followed_from_step_to_step(rng):
         out = {name: np.empty_like(array) for name, array in cells.items()}
         out["r"] = cells["r"]  # last step's radii, overwritten in place
         done = stepper.update_cells(
-            position, radius, step == 2, False, width, height, ncx, ncy, cells["order"],
+            position, radius, step == 2, False, _window(width, height), ncx, ncy, cells["order"],
             cells["key"], np.empty((n, 2)), np.empty(n), np.empty(n, np.int32),
             np.empty(n, np.int32), np.empty(n, np.int32),
             np.empty(stepper.chunk_count(n), np.int64), out["order"],
@@ -115,7 +144,8 @@ def test_cells_are_followed_from_step_to_step(rng):
     scattered = rng.uniform(-0.5, 0.5, (n, 2)) * [width, height]
     work = [np.empty(n, np.int32) for _ in range(5)]
     assert not stepper.update_cells(
-        scattered, radius, False, False, width, height, ncx, ncy, cells["order"], cells["key"],
+        scattered, radius, False, False, _window(width, height), ncx, ncy, cells["order"],
+        cells["key"],
         np.empty((n, 2)), np.empty(n), work[0], work[1], work[2],
         np.empty(stepper.chunk_count(n), np.int64), work[3], work[4], np.empty_like(cells["start"]),
         np.empty((n, 2)), np.empty(n),
@@ -168,6 +198,21 @@ def test_pair_search_lists_every_overlap_once(rng, periodic, uniform):
     for general in (False, True):
         got = _pairs(cells, ncx, ncy, width, height, periodic, general, uniform)
         np.testing.assert_array_equal(got, want)
+
+
+def test_pair_search_on_cells_over_part_of_the_box_lists_every_overlap(rng):
+    """Cells over a window smaller than where the disks are (`cells.grid_window` after the
+    disks spread out): those outside share its edge cells, and no overlap is missed."""
+    width, height, n = 12.0, 9.0, 600
+    radius = rng.uniform(0.05, 0.35, n)
+    position = rng.uniform(-0.5, 0.5, (n, 2)) * [width, height]
+    want = _all_overlaps(position, radius, width, height, False)
+    assert len(want) > 100
+    ncx, ncy, _ = stepper.step_grid(0.3 * width, 0.3 * height, 2 * radius.max(), n, False)
+    assert ncx * ncy > 9
+    cells = _sorted(position, radius, width, height, ncx, ncy, scale=0.3)
+    _check_sorted(cells, position, radius, 0.3 * width, 0.3 * height, ncx, ncy)
+    np.testing.assert_array_equal(_pairs(cells, ncx, ncy, width, height, False, False), want)
 
 
 def _seed_search(position, radius, width, height, ncx, ncy):

@@ -5,27 +5,13 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 import pytest
 
 from collidium import Box, Circle, Particles, Polygon, Simulation
-from collidium.vessels import Vessel
+from collidium.initial import hexagonal_positions
 
 RADIUS = 0.25
 PACKING = 0.6
-
-
-def hexagonal_inside(vessel: Vessel, rng: np.random.Generator) -> np.ndarray:
-    """Centres of a hexagonal lattice at `PACKING` (of the plane), those whose disk is inside."""
-    spacing = RADIUS * math.sqrt(2 * math.pi / (math.sqrt(3) * PACKING))
-    (x0, y0), (x1, y1) = vessel.bounds
-    rows = np.arange(y0, y1, spacing * math.sqrt(3) / 2)
-    points = [(x + (k % 2) * spacing / 2, y) for k, y in enumerate(rows)
-              for x in np.arange(x0, x1, spacing)]  # fmt: skip
-    centres = np.array(points)
-    inside = np.ones(len(centres), dtype=bool)
-    inside[vessel.outside(centres, np.full(len(centres), RADIUS * (1 + 1e-6)))] = False
-    return centres[inside]
 
 
 #: A five-pointed star: five reflex corners.
@@ -40,7 +26,7 @@ STAR = Polygon([
 )
 @pytest.mark.slow
 def test_ten_million_collisions_at_packing_0_6_with_a_disk_at_1000_m_per_s(vessel, rng):
-    position = hexagonal_inside(vessel, rng)
+    position = hexagonal_positions(vessel, RADIUS, PACKING)
     n = len(position)
     velocity = rng.normal(0.0, 1.0, (n, 2))
     velocity[n // 2] = [1000.0 * math.cos(0.3), 1000.0 * math.sin(0.3)]

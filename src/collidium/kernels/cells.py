@@ -1,8 +1,14 @@
-"""Uniform cell grid over the box: linked lists of particles per cell, neighbour cells, overlaps.
+"""Uniform cell grid: linked lists of particles per cell, neighbour cells, overlaps.
 
 Cells are at least one largest diameter wide, so two disks in contact always sit in the same or
 adjacent cells. Radius-0 particles are in the grid too (the event engine wraps particles through
 cell crossings in a periodic box) but every pair loop skips them: they never collide.
+
+A grid covers a window, `grid_window`: the periodic box itself (its cells wrap), else the disks'
+bounding box within the vessel's, so that disks packed in a corner of a large vessel are not all
+in a few cells (which makes every search over neighbours quadratic). The cells along the
+window's edges reach on to infinity (indices are clamped): a disk outside the window is still in
+the cell next to the window, and disks in contact are still in the same or adjacent cells.
 """
 
 from __future__ import annotations
@@ -11,12 +17,14 @@ import math
 
 import numba
 import numpy as np
+from numpy.typing import ArrayLike
 
 
 @numba.njit(cache=True, inline="always")
-def cell_index(x: float, half: float, cell: float, count: int) -> int:
-    """Index along one axis of the cell holding coordinate ``x`` (clamped to the grid)."""
-    k = math.floor((x + half) / cell)
+def cell_index(x: float, low: float, cell: float, count: int) -> int:
+    """Index along one axis of the cell holding coordinate ``x`` (clamped to the grid), for a
+    grid starting at ``low`` with cells ``cell`` wide (m)."""
+    k = math.floor((x - low) / cell)
     return min(max(k, 0), count - 1)
 
 
@@ -24,8 +32,10 @@ def cell_index(x: float, half: float, cell: float, count: int) -> int:
 def fill_cells(
     position: np.ndarray,
     radius: np.ndarray,
-    half_width: float,
-    half_height: float,
+    low_x: float,
+    low_y: float,
+    cell_width: float,
+    cell_height: float,
     ncx: int,
     ncy: int,
     cell_of: np.ndarray,
@@ -38,26 +48,26 @@ def fill_cells(
     Parameters
     ----------
     position : ndarray, shape (N, 2)
-        Centres in m (inside the box).
+        Centres in m.
     radius : ndarray, shape (N,)
         Radii in m (unused; kept so all cell kernels take the same arrays).
-    half_width, half_height : float
-        Half sides of the box in m.
+    low_x, low_y : float
+        Lower-left corner of the grid's window in m.
+    cell_width, cell_height : float
+        Cell sides in m.
     ncx, ncy : int
         Cells along x and y.
     cell_of, head, next_, prev : ndarray of int64
         Outputs: cell of each particle (N,), first particle of each cell (ncx*ncy,), and the
         next/previous particle in the same cell (N,); -1 ends a list.
     """
-    cw = 2.0 * half_width / ncx
-    ch = 2.0 * half_height / ncy
     head[:] = -1
     # Insert in reverse index order so each list reads in increasing index order.
     for i in range(position.shape[0] - 1, -1, -1):
         next_[i] = -1
         prev[i] = -1
-        c = cell_index(position[i, 0], half_width, cw, ncx) + ncx * cell_index(
-            position[i, 1], half_height, ch, ncy
+        c = cell_index(position[i, 0], low_x, cell_width, ncx) + ncx * cell_index(
+            position[i, 1], low_y, cell_height, ncy
         )
         cell_of[i] = c
         first = head[c]
@@ -101,21 +111,29 @@ def first_overlap(
     width: float,
     height: float,
     periodic: bool,
+    window: np.ndarray,
     ncx: int,
     ncy: int,
 ) -> tuple[int, int]:
     """The overlapping pair ``(i, j)``, i < j, with the smallest i then j, or ``(-1, -1)``.
 
-    Two disks overlap when their centres are closer than the sum of their radii by more than a
-    relative 1e-12 (round-off). Radius-0 particles never overlap anything. Grids under 3 cells
-    wide see a cell under several periodic shifts, so every image within reach is considered.
+    ``width`` and ``height`` are the box's sides (m), for the periodic images; ``window``,
+    ``[[x0, y0], [x1, y1]]`` (m), is the rectangle the ``ncx`` by ``ncy`` cells cover (the box
+    itself when periodic, `grid_window`). Two disks overlap when their centres are closer than
+    the sum of their radii by more than a relative 1e-12 (round-off). Radius-0 particles never
+    overlap anything. Grids under 3 cells wide see a cell under several periodic shifts, so every
+    image within reach is considered.
     """
     n = position.shape[0]
     cell_of = np.empty(n, dtype=np.int32)
     head = np.empty(ncx * ncy, dtype=np.int32)
     next_ = np.empty(n, dtype=np.int32)
     prev = np.empty(n, dtype=np.int32)
-    fill_cells(position, radius, 0.5 * width, 0.5 * height, ncx, ncy, cell_of, head, next_, prev)
+    low_x, low_y = window[0, 0], window[0, 1]
+    cell_width = (window[1, 0] - low_x) / ncx
+    cell_height = (window[1, 1] - low_y) / ncy
+    fill_cells(position, radius, low_x, low_y, cell_width, cell_height, ncx, ncy, cell_of, head,
+               next_, prev)  # fmt: skip
     for i in range(n):
         if radius[i] <= 0.0:
             continue
@@ -141,8 +159,72 @@ def first_overlap(
     return -1, -1
 
 
+@numba.njit(cache=True)
+def bounding_box(position: np.ndarray) -> tuple[float, float, float, float]:
+    """``(x0, y0, x1, y1)`` (m): the smallest rectangle holding every point of ``position``
+    (N, 2), N >= 1."""
+    x0 = x1 = position[0, 0]
+    y0 = y1 = position[0, 1]
+    for i in range(1, position.shape[0]):
+        x, y = position[i, 0], position[i, 1]
+        x0, x1 = min(x0, x), max(x1, x)
+        y0, y1 = min(y0, y), max(y1, y)
+    return x0, y0, x1, y1
+
+
+#: Disks from which a grid covers only their surroundings: fewer are searched quickly whatever
+#: the grid, and a small scene keeps the whole vessel's few cells (and so the same round-off as
+#: ever: no cell crossings where there were none).
+WINDOW_FROM = 4096
+
+#: The window of a grid reaches past the disks' bounding box by this share of its larger side
+#: (and at least a diameter): disks that spread out leave it only after moving that far, and
+#: each new window is larger by that much (`collidium.collisions` makes a new one then).
+WINDOW_MARGIN = 0.25
+
+
+def grid_window(
+    position: np.ndarray, diameter: float, extent: ArrayLike, periodic: bool
+) -> np.ndarray:
+    """The rectangle ``[[x0, y0], [x1, y1]]`` (m) a cell grid covers.
+
+    Parameters
+    ----------
+    position : ndarray, shape (N, 2)
+        Disk centres in m.
+    diameter : float
+        Largest diameter in m.
+    extent : array_like, shape (2,)
+        Sides (m) of the vessel's bounding box, centred on the origin.
+    periodic : bool
+        A periodic box: the grid then covers the box, whose cells wrap.
+
+    Returns
+    -------
+    ndarray, shape (2, 2)
+        The disks' bounding box grown by `WINDOW_MARGIN` of its larger side and a diameter on
+        every side, within the vessel's bounding box; that box itself when periodic, for fewer
+        than `WINDOW_FROM` disks, or when that leaves no area (point particles in a line).
+    """
+    half = 0.5 * np.asarray(extent, dtype=np.float64)
+    box = np.array([-half, half])
+    if periodic or position.shape[0] < WINDOW_FROM:
+        return box
+    x0, y0, x1, y1 = bounding_box(position)
+    reach = diameter + WINDOW_MARGIN * max(x1 - x0, y1 - y0)
+    low = np.maximum(np.array([x0, y0]) - reach, -half)
+    high = np.minimum(np.array([x1, y1]) + reach, half)
+    return np.array([low, high]) if (high > low).all() else box
+
+
+def window_sides(window: np.ndarray) -> tuple[float, float]:
+    """Width and height (m) of a window ``[[x0, y0], [x1, y1]]``."""
+    return float(window[1, 0] - window[0, 0]), float(window[1, 1] - window[0, 1])
+
+
 def grid_shape(width: float, height: float, max_diameter: float, n: int) -> tuple[int, int]:
-    """Cells along x and y: at least one diameter wide, at most about 2 cells per particle."""
+    """Cells along x and y of a window ``width`` by ``height`` (m): at least one diameter wide,
+    at most about 2 cells per particle."""
     if max_diameter <= 0.0:
         return 1, 1
     ncx = max(1, int(width // max_diameter))
@@ -160,9 +242,9 @@ EVENT_CELLS_PER_PARTICLE = 3
 
 
 def event_grid_shape(width: float, height: float, max_diameter: float, n: int) -> tuple[int, int]:
-    """Cells along x and y for the event engine: as small as one largest diameter (the fewest
-    neighbours to test per prediction; measured fastest at packing 0.3), at most
-    `EVENT_CELLS_PER_PARTICLE` cells per particle."""
+    """Cells along x and y of a window (m) for the event engine: as small as one largest
+    diameter (the fewest neighbours to test per prediction; measured fastest at packing 0.3), at
+    most `EVENT_CELLS_PER_PARTICLE` cells per particle."""
     if max_diameter <= 0.0:
         return 1, 1
     size = max(max_diameter, math.sqrt(width * height / (EVENT_CELLS_PER_PARTICLE * max(n, 1))))

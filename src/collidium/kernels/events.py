@@ -60,10 +60,11 @@ SHARED_BODY_COLUMNS = 5  # 40 bytes: every disk has the radius and mass in ``geo
 #: box, the cell sides, the radius and mass of every disk when the rows have no columns for them
 #: (else NaN), the vessel's shape code (`collidium.kernels.vessels`) and, for a circle, its radius;
 #: then the pair collisions' restitution and the approach speed (m/s) below which they are
-#: elastic (`collidium.kernels.collision.pair_response`).
+#: elastic (`collidium.kernels.collision.pair_response`); then the lower-left corner of the
+#: cells' window (`collidium.kernels.cells.grid_window`: the box itself when periodic).
 HALF_WIDTH, HALF_HEIGHT, CELL_WIDTH, CELL_HEIGHT, SHARED_RADIUS, SHARED_MASS, SHAPE, RIM = range(8)
-RESTITUTION, ELASTIC_BELOW = 8, 9
-GEOMETRY_SIZE = 10
+RESTITUTION, ELASTIC_BELOW, GRID_LEFT, GRID_BOTTOM = 8, 9, 10, 11
+GEOMETRY_SIZE = 12
 
 #: Columns of the ``event`` rows (int32): the next event's code, the earliest pair contact found
 #: (its partner's slot, or -1; the event itself if it comes first) and that partner's collision
@@ -300,19 +301,19 @@ def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid, segments, piston, now):
                                           segments)  # fmt: skip
         if contact >= 0:
             code = FIRST_WALL_CODE - contact
-    for d in range(2):  # cell crossings: -1 - (2 d + upper)
+    for d in range(2):  # cell crossings: -1 - (2 d + upper); none out of the edge cells
         v = vx if d == 0 else vy
         pos = x if d == 0 else y
-        half = hw if d == 0 else hh
+        low = geometry[GRID_LEFT + d]
         size = geometry[CELL_WIDTH + d]
         at = c % ncx if d == 0 else c // ncx
         cells = grid[d]
         if v > 0.0 and (periodic or at < cells - 1):
-            delay = max((-half + (at + 1) * size - pos) / v, 0.0)
+            delay = max((low + (at + 1) * size - pos) / v, 0.0)
             if delay < best:
                 best, code = delay, -2 - 2 * d
         elif v < 0.0 and (periodic or at > 0):
-            delay = max((-half + at * size - pos) / v, 0.0)
+            delay = max((low + at * size - pos) / v, 0.0)
             if delay < best:
                 best, code = delay, -1 - 2 * d
     return best, code
@@ -550,14 +551,12 @@ def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event
     `load`); this sets the stamps, sorts the slots by cell and predicts every event.
     """
     n = body.shape[0]
-    hw = geometry[HALF_WIDTH]
-    hh = geometry[HALF_HEIGHT]
     ncx = grid[0]
     for k in range(n):
         body[k, STAMP] = now
-        cell_of[k] = cell_index(body[k, X], hw, geometry[CELL_WIDTH], ncx) + ncx * cell_index(
-            body[k, Y], hh, geometry[CELL_HEIGHT], grid[1]
-        )
+        cell_of[k] = cell_index(
+            body[k, X], geometry[GRID_LEFT], geometry[CELL_WIDTH], ncx
+        ) + ncx * cell_index(body[k, Y], geometry[GRID_BOTTOM], geometry[CELL_HEIGHT], grid[1])
         count[k] = 0
         event[k, CODE] = NO_EVENT
         event[k, KEPT] = -1
@@ -935,17 +934,26 @@ def load(position, velocity, radius, mass, body, ident) -> None:
 
 
 @_engine()
-def synchronise(now, body, ident, position, velocity) -> None:
+def synchronise(now, body, ident, geometry, grid, position, velocity) -> int:
     """Write every particle's position at time ``now`` (s) and velocity into ``position`` and
     ``velocity`` (N, 2), by particle; the lazily kept state is untouched so the queue stays
-    valid."""
+    valid. Returns how many particles are outside the cells' window (they share its edge cells:
+    right, but slow when they are many)."""
+    x0, y0 = geometry[GRID_LEFT], geometry[GRID_BOTTOM]
+    x1 = x0 + grid[0] * geometry[CELL_WIDTH]
+    y1 = y0 + grid[1] * geometry[CELL_HEIGHT]
+    strays = 0
     for k in range(body.shape[0]):
         i = ident[k]
         lag = now - body[k, STAMP]
-        position[i, 0] = body[k, X] + body[k, VX] * lag
-        position[i, 1] = body[k, Y] + body[k, VY] * lag
+        x = body[k, X] + body[k, VX] * lag
+        y = body[k, Y] + body[k, VY] * lag
+        position[i, 0] = x
+        position[i, 1] = y
         velocity[i, 0] = body[k, VX]
         velocity[i, 1] = body[k, VY]
+        strays += not (x0 <= x <= x1 and y0 <= y <= y1)
+    return strays
 
 
 @_engine()

@@ -49,7 +49,7 @@ def step_grid(
     Parameters
     ----------
     width, height : float
-        Box sides in m.
+        Sides of the grid's window in m (`cells.grid_window`: the box itself when periodic).
     max_diameter : float
         Largest disk diameter in m.
     n : int
@@ -82,9 +82,9 @@ def step_grid(
 
 
 @numba.njit(cache=True, inline="always")
-def _cell(x: float, half: float, cell: float, count: int) -> int:
+def _cell(x: float, low: float, cell: float, count: int) -> int:
     """Index along one axis of the cell holding ``x`` (clamped), as `cells.cell_index`."""
-    k = math.floor((x + half) / cell)
+    k = math.floor((x - low) / cell)
     return min(max(k, 0), count - 1)
 
 
@@ -155,8 +155,7 @@ def sort_into_cells(
     position: np.ndarray,
     radius: np.ndarray,
     uniform: bool,
-    width: float,
-    height: float,
+    window: np.ndarray,
     ncx: int,
     ncy: int,
     band_index: np.ndarray,
@@ -185,8 +184,9 @@ def sort_into_cells(
     uniform : bool
         All radii are equal: ``cell_r`` is left alone (it holds that radius in every entry, in
         any order).
-    width, height : float
-        Box sides in m.
+    window : ndarray, shape (2, 2)
+        Lower-left and upper-right corners (m) of the rectangle the cells cover
+        (`cells.grid_window`); particles outside it are in its edge cells.
     ncx, ncy : int
         Grid shape.
     band_index : ndarray of int, shape (N,)
@@ -206,16 +206,15 @@ def sort_into_cells(
         search.
     """
     n = position.shape[0]
-    half_width = 0.5 * width
-    half_height = 0.5 * height
-    cw = 2.0 * half_width / ncx
-    ch = 2.0 * half_height / ncy
+    low_x, low_y = window[0, 0], window[0, 1]
+    cw = (window[1, 0] - low_x) / ncx
+    ch = (window[1, 1] - low_y) / ncy
     chunks = chunk_count(n)
     rows = np.zeros((chunks, ncy), dtype=np.int64)
     # Row of each particle (kept in `order` for now), counted per chunk.
     for p in numba.prange(chunks):
         for i in range(_u(p * n // chunks), _u((p + 1) * n // chunks)):
-            row = _cell(position[i, 1], half_height, ch, ncy)
+            row = _cell(position[i, 1], low_y, ch, ncy)
             order[i] = row
             rows[p, row] += 1
     # Where each chunk's share of each row begins: rows in order, chunks in order within a row.
@@ -239,7 +238,7 @@ def sort_into_cells(
         for cx in range(ncx):
             cursor[base + cx] = 0
         for s in range(lo, hi):
-            cursor[base + _cell(band_xy[s, 0], half_width, cw, ncx)] += 1
+            cursor[base + _cell(band_xy[s, 0], low_x, cw, ncx)] += 1
         at = row_start[row]
         for cx in range(ncx):
             count = cursor[base + cx]
@@ -247,7 +246,7 @@ def sort_into_cells(
             cursor[base + cx] = at
             at += count
         for s in range(lo, hi):
-            c = base + _cell(band_xy[s, 0], half_width, cw, ncx)
+            c = base + _cell(band_xy[s, 0], low_x, cw, ncx)
             t = _u(cursor[c])
             cursor[c] += 1
             order[t] = band_index[s]
@@ -265,8 +264,8 @@ def _gather_chunk(
     radius: np.ndarray,
     fresh_radius: bool,
     uniform: bool,
-    half_width: float,
-    half_height: float,
+    low_x: float,
+    low_y: float,
     cw: float,
     ch: float,
     ncx: int,
@@ -298,7 +297,7 @@ def _gather_chunk(
         us = _u(s)
         x = data_xy[us, 0]
         y = data_xy[us, 1]
-        c = _cell(x, half_width, cw, ncx) + ncx * _cell(y, half_height, ch, ncy)
+        c = _cell(x, low_x, cw, ncx) + ncx * _cell(y, low_y, ch, ncy)
         new_key[us] = c
         if c != key[us]:
             movers[_u(lo + count)] = s
@@ -312,8 +311,7 @@ def _gather(
     radius: np.ndarray,
     fresh_radius: bool,
     uniform: bool,
-    width: float,
-    height: float,
+    window: np.ndarray,
     ncx: int,
     ncy: int,
     order: np.ndarray,
@@ -333,13 +331,12 @@ def _gather(
     """
     n = order.shape[0]
     chunks = moved.shape[0]
-    half_width = 0.5 * width
-    half_height = 0.5 * height
-    cw = 2.0 * half_width / ncx
-    ch = 2.0 * half_height / ncy
+    low_x, low_y = window[0, 0], window[0, 1]
+    cw = (window[1, 0] - low_x) / ncx
+    ch = (window[1, 1] - low_y) / ncy
     for p in numba.prange(chunks):
         moved[p] = _gather_chunk(
-            position, radius, fresh_radius, uniform, half_width, half_height, cw, ch, ncx, ncy,
+            position, radius, fresh_radius, uniform, low_x, low_y, cw, ch, ncx, ncy,
             order, key, cell_r, data_xy, data_r, new_key, movers, p * n // chunks,
             (p + 1) * n // chunks,
         )  # fmt: skip
@@ -451,8 +448,7 @@ def update_cells(
     radius: np.ndarray,
     fresh_radius: bool,
     uniform: bool,
-    width: float,
-    height: float,
+    window: np.ndarray,
     ncx: int,
     ncy: int,
     order: np.ndarray,
@@ -488,8 +484,9 @@ def update_cells(
     uniform : bool
         All radii are equal: ``cell_r`` is left alone (it holds that radius in every entry, in
         any order).
-    width, height : float
-        Box sides in m.
+    window : ndarray, shape (2, 2)
+        Lower-left and upper-right corners (m) of the rectangle the cells cover
+        (`cells.grid_window`); particles outside it are in its edge cells.
     ncx, ncy : int
         Grid shape.
     order, key : ndarray of int, shape (N,)
@@ -517,7 +514,7 @@ def update_cells(
     n = order.shape[0]
     ncells = ncx * ncy
     _gather(
-        position, radius, fresh_radius, uniform, width, height, ncx, ncy, order, key, cell_r,
+        position, radius, fresh_radius, uniform, window, ncx, ncy, order, key, cell_r,
         data_xy, data_r, new_key, movers, moved,
     )  # fmt: skip
     chunks = moved.shape[0]

@@ -24,6 +24,7 @@ from collidium.scenario import Scenario
 from collidium.simulation import Simulation
 from collidium.state import FloatArray, uniform_or_each
 from collidium.viewer import protocol
+from collidium.viewer.builder import BUILDER
 
 #: Bins of the live speed histogram.
 HISTOGRAM_BINS = 30
@@ -80,9 +81,7 @@ class ViewerSession:
     def _install(self, scenario: Scenario, name: str | None, overrides: dict[str, Any]) -> None:
         field = "n" if "n" in overrides else "particles"
         _check_size(scenario.particle_count, bool(scenario.forces), field)
-        sim = scenario.build()
-        sim.observers.clear()
-        self._start(sim, scenario, name, overrides)
+        self._start(BUILDER.build(scenario, field), scenario, name, overrides)
 
     def _start(
         self,
@@ -116,9 +115,7 @@ class ViewerSession:
     def _fresh(self) -> Simulation:
         """A new simulation in the starting state."""
         if self._scenario is not None:
-            sim = self._scenario.build()
-            sim.observers.clear()
-            return sim
+            return BUILDER.build(self._scenario)
         return self._initial.copy()
 
     # -- controls ---------------------------------------------------------------------------
