@@ -42,15 +42,21 @@ export function createReadouts(container) {
   }
 
   return {
-    /** Shows a stats message; the pressure label says whether it is the wall or virial pressure. */
+    /** Shows a stats message; the pressure label says whether it is the wall or virial pressure,
+     * and the drift is marked (its warning line as the tooltip) once it passed the limit. */
     update(stats) {
       for (const cell of cells) show(cell, cell.spec.read(stats));
       const pressure = cells.find((cell) => cell.spec.id === "readout-pressure");
       pressure.label.textContent = stats.pressure_kind ? `pressure (${stats.pressure_kind})` : "pressure";
+      const drift = cells.find((cell) => cell.spec.id === "readout-drift");
+      const warning = typeof stats.warning === "string" ? stats.warning : "";
+      drift.value.classList.toggle("warning", warning !== "");
+      drift.value.title = warning;
+      drift.value.dataset.warning = warning;
     },
     /** Blanks every readout but N (a new scene has no stats yet). */
     reset(n) {
-      for (const cell of cells) show(cell, cell.spec.id === "readout-n" ? n : null);
+      this.update({ n });
     },
   };
 }

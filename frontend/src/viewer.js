@@ -226,6 +226,7 @@ export function mountViewer(root, transport) {
     state.drawnFrame = null;
     state.drag = null;
     state.warnedSize = false;
+    state.warnedDrift = false;
     viewport.setVessel(scene.vessel?.bounds);
     renderer.setScene(scene);
     trace.follow(null);
@@ -243,6 +244,8 @@ export function mountViewer(root, transport) {
   function applyStats(stats) {
     state.stats = stats;
     readouts.update(stats);
+    if (stats.warning && !state.warnedDrift) report("energy", stats.warning); // once a scene
+    state.warnedDrift = Boolean(stats.warning);
     energyPlot.append(stats);
     speedPlot.update(stats.histogram);
   }

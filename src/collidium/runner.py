@@ -29,7 +29,8 @@ from collidium.observers import (
     Thermo,
     Trigger,
 )
-from collidium.observers.energy import conserved_energy
+from collidium.observers.energy import DRIFT_WARNING, conserved_energy
+from collidium.observers.energy import drift_warning as drift_warning_line
 from collidium.scenario import build_observers
 from collidium.simulation import Simulation, restore_with_meta
 
@@ -38,10 +39,6 @@ OUTPUT_SUFFIXES = (".gsd", ".xyz")
 
 #: How many samples the run's own measurements take at most (their collision parts are exact).
 SAMPLES = 500
-
-#: Largest relative energy drift a run reports without a warning (``--max-drift`` sets another
-#: and makes passing it a failure). The adaptive integrator keeps the seed scenes below 1e-5.
-DRIFT_WARNING = 1e-3
 
 
 @dataclass
@@ -311,13 +308,7 @@ def drift_exceeded(job: Job) -> bool:
 
 def drift_warning(job: Job) -> str | None:
     """One line saying that the energy drifted past the run's limit, or None."""
-    if not drift_exceeded(job):
-        return None
-    return (
-        f"the total energy drifted by {job.max_rel_drift:.3g} of its initial value (limit "
-        f"{job.drift_limit:g}): try a smaller run.tolerance, or a smaller dt with the fixed "
-        "integrator"
-    )
+    return drift_warning_line(job.max_rel_drift, job.drift_limit)
 
 
 def finite(value: Any) -> Any:

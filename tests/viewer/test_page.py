@@ -4,6 +4,7 @@ controls changing the simulation as they say."""
 from __future__ import annotations
 
 import io
+import json
 import math
 from pathlib import Path
 
@@ -137,6 +138,24 @@ def test_a_malformed_message_gets_an_error_and_the_next_good_one_works(page):
     assert "message" in page.inner_text("#message")
     pause(page)  # the next good message is obeyed
     assert page.inner_text("#play").strip() == "Play"
+
+
+def test_an_energy_drift_past_the_limit_is_marked_and_said(page):
+    """The seed's charged gas at k = 5000 with the fixed step: its energy explodes, and the
+    page says so (the drift readout marked, its warning line in the message bar)."""
+    load = {"type": "load", "preset": "charged-gas",
+            "overrides": {"k": 5000, "integrator": "fixed"}}  # fmt: skip
+    page.evaluate(f"window.collidiumViewer.sendRaw({json.dumps(json.dumps(load))})")
+    page.wait_for_function(
+        "document.querySelector('#readout-drift').classList.contains('warning')", timeout=60_000
+    )
+    warning = page.get_attribute("#readout-drift", "title")
+    assert warning.startswith("the total energy drifted by") and "limit 0.001" in warning
+    assert page.inner_text("#message").startswith("energy: the total energy drifted by")
+    assert abs(readout(page, "drift")) > 1e-3
+    page.select_option("#preset", "gas")  # a new scene starts unmarked
+    page.wait_for_function("document.querySelector('#readout-n').dataset.value === '200'")
+    assert "warning" not in page.get_attribute("#readout-drift", "class")
 
 
 def test_collisions_toggle_and_download_give_what_they_say(page):

@@ -5,12 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from collidium.errors import InputError
+from collidium.errors import InputError, SimulationError
 from collidium.observers.thermo import Thermo
 from collidium.presets import preset
 from collidium.scenario import Scenario
 from collidium.theory import MaxwellBoltzmann2D
 from collidium.viewer import protocol
+from collidium.viewer import session as session_module
 from collidium.viewer.session import WINDOW_SAMPLES, ViewerSession
 
 
@@ -19,10 +20,13 @@ def gas() -> ViewerSession:
     return ViewerSession(preset("gas", n=100), preset="gas", overrides={"n": 100})
 
 
-def test_the_first_advance_runs_one_step_to_learn_its_cost_and_keeps_the_rest(gas):
+def test_the_first_advances_run_one_step_each_to_learn_its_cost_and_keep_the_rest(gas):
+    """The first step loads the kernels (untimed), the second learns what a step costs."""
     gas.advance(0.1, budget=10.0)
-    assert gas.sim.steps == 1 and gas._seconds_per_step > 0
-    gas.advance(0.0, budget=10.0)  # the 9 steps still owed are run
+    assert gas.sim.steps == 1 and gas._seconds_per_step is None
+    gas.advance(0.0, budget=10.0)
+    assert gas.sim.steps == 2 and gas._seconds_per_step > 0
+    gas.advance(0.0, budget=10.0)  # the 8 steps still owed are run
     assert gas.sim.steps == 10
 
 
@@ -234,3 +238,26 @@ def test_the_scene_sends_an_l_shaped_vessel_filled_and_its_partition():
     assert (areas > 0).all() and areas.sum() == pytest.approx(64.0)  # none outside, all covered
     assert vessel["partition_lines"] == [[[2.0, 0.0], [2.0, 4.0]], [[2.0, 6.0], [2.0, 10.0]]]
     assert vessel["walls"][-1] == "p" and vessel["partitions"][0]["gap"] == 2.0
+
+
+def test_stats_carry_a_warning_once_the_energy_drifted_past_the_limit(gas):
+    assert gas.stats()["warning"] is None
+    exploding = ViewerSession(preset("charged-gas", k=5000.0, integrator="fixed"))
+    for _ in range(100):
+        exploding.step()
+        if exploding.stats()["warning"]:
+            break
+    warning = exploding.stats()["warning"]
+    assert warning.startswith("the total energy drifted by") and "(limit 0.001)" in warning
+    exploding.reset()
+    assert exploding.stats()["warning"] is None
+
+
+def test_a_step_too_slow_to_watch_pauses_but_the_first_is_not_judged(gas, monkeypatch):
+    """The first step also loads the kernels, so only later steps are held to the limit."""
+    monkeypatch.setattr(session_module, "MAX_STEP_SECONDS", 0.0)
+    gas.advance(0.01, budget=10.0)
+    assert gas.sim.steps == 1 and gas.playing
+    with pytest.raises(SimulationError, match="too slow to watch"):
+        gas.advance(0.01, budget=10.0)
+    assert not gas.playing

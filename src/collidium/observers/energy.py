@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -130,6 +131,23 @@ def plot_energy(
     lines = ax.get_lines() + speed_axis.get_lines()
     ax.legend(lines, [str(line.get_label()) for line in lines], loc="lower right", fontsize="small")
     return ax
+
+
+#: Largest relative energy drift a run reports without a warning (the command line's
+#: ``--max-drift`` sets another and makes passing it a failure; the viewer marks its readout).
+#: The adaptive integrator keeps the seed scenes below 1e-5.
+DRIFT_WARNING = 1e-3
+
+
+def drift_warning(drift: float, limit: float = DRIFT_WARNING) -> str | None:
+    """One line saying that the total energy drifted by ``drift`` (relative) past ``limit``, or
+    None (also when the drift cannot be measured: NaN, a zero initial energy)."""
+    if not (math.isfinite(drift) and abs(drift) > limit):
+        return None
+    return (
+        f"the total energy drifted by {abs(drift):.3g} of its initial value (limit {limit:g}): "
+        "try a smaller run.tolerance, or a smaller dt with the fixed integrator"
+    )
 
 
 class EnergyDrift(Measurement):

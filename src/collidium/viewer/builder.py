@@ -9,6 +9,7 @@ is killed, a fresh one started at the next request) with one error line naming t
 
 from __future__ import annotations
 
+import atexit
 import socket
 import subprocess
 import sys
@@ -129,5 +130,7 @@ def serve(descriptor: int) -> None:
             pipe.send((False, (None, f"cannot be built ({type(exc).__name__}: {exc})", ())))
 
 
-#: The builder of this process's viewer sessions (its worker starts at the first build).
+#: The builder of this process's viewer sessions (its worker starts at the first build, and
+#: stops when this process ends).
 BUILDER = Builder()
+atexit.register(BUILDER.close)

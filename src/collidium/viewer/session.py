@@ -16,7 +16,7 @@ import numpy as np
 
 from collidium import __version__
 from collidium.errors import InputError, SimulationError
-from collidium.observers.energy import conserved_energy
+from collidium.observers.energy import conserved_energy, drift_warning
 from collidium.observers.speeds import SpeedHistogram
 from collidium.observers.thermo import Thermo
 from collidium.presets import PRESETS, describe_presets, preset
@@ -99,13 +99,17 @@ class ViewerSession:
         self.traced: int | None = None
         self.generation += 1
         self._carry = 0.0
-        self._seconds_per_step: float | None = None  # measured on the first step
+        # Measured on the second step: the first also loads the kernels (the scenario was
+        # built in another process), and is neither timed nor judged.
+        self._seconds_per_step: float | None = None
+        self._loaded = False
         self._upper_speed = 0.0
         self._changed()
 
     def _changed(self) -> None:
         """The state was changed from outside the dynamics: restart the drift and the windows."""
         self._reference = conserved_energy(self.sim)
+        self._worst_drift = 0.0  # largest relative energy drift since
         self._thermo = Thermo()
         self._pressure: float | None = None
         self._rate: float | None = None
@@ -223,6 +227,9 @@ class ViewerSession:
         start = clock.perf_counter()
         self._run(count)
         spent = (clock.perf_counter() - start) / count
+        if not self._loaded:
+            self._loaded = True
+            return
         self._seconds_per_step = spent if per_step is None else 0.7 * per_step + 0.3 * spent
         if spent > MAX_STEP_SECONDS:
             self.playing = False
@@ -302,11 +309,14 @@ class ViewerSession:
         kT = energy.kinetic / n if n else None
         conserved = conserved_energy(sim)
         drift = (conserved - self._reference) / abs(self._reference) if self._reference else None
+        if drift is not None and math.isfinite(drift):
+            self._worst_drift = max(self._worst_drift, abs(drift))
         return {
             "type": "stats", "time": sim.time, "steps": sim.steps, "n": n,
             "temperature": _number(kT), "pressure": self._pressure,
             "pressure_kind": "virial" if sim.container.periodic else "wall",
             "collision_rate": self._rate, "drift": _number(drift),
+            "warning": drift_warning(self._worst_drift),
             "energy": {"kinetic": _number(energy.kinetic), "potential": _number(energy.potential),
                        "total": _number(energy.total)},
             "total_speed": _number(sim.total_speed()), "histogram": self._histogram(kT),
