@@ -204,6 +204,32 @@ def test_a_pipe_is_refused_at_once_rather_than_read_forever(tmp_path):
     assert result.returncode == 2 and result.stderr == f"error: {pipe}: not a regular file\n"
 
 
+@pytest.mark.parametrize("limit", [0, 20_000])
+@pytest.mark.parametrize("output", [("--out", "run.gsd"), ("--out", "run.xyz"),
+                                    ("--checkpoint", "run.ckpt")])  # fmt: skip
+def test_a_file_that_cannot_grow_gets_one_line_and_exit_2(tmp_path, output, limit):
+    """Writes that fail as on a full disk (here: past a file-size limit, EFBIG) end the run with
+    one line naming the user's file; no staging or temporary file is left behind."""
+    import resource
+
+    def limit_file_size() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    result = subprocess.run(
+        [sys.executable, "-m", "collidium", "run", "gas", "--time", "5", *output],
+        capture_output=True, text=True, cwd=tmp_path, timeout=300, preexec_fn=limit_file_size,
+    )  # fmt: skip
+    name = output[1]
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.count("\n") == 1 and "Traceback" not in result.stderr
+    assert f"{tmp_path / name}: cannot write" in result.stderr and "File too large" in result.stderr
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert left == (["run.gsd"] if name == "run.gsd" and limit > 0 else [])
+    if left:  # the frames flushed before the failure are readable
+        inspected = collidium("inspect", "run.gsd", "--json", cwd=tmp_path)
+        assert inspected.returncode == 0 and json.loads(inspected.stdout)["frames"] >= 1
+
+
 def test_bad_toml_error_names_the_line(tmp_path):
     file = tmp_path / "broken.toml"
     file.write_text(BAD_TOML)

@@ -239,18 +239,24 @@ def write_plots(trajectory: Trajectory, folder: str | Path) -> list[Path]:
     """
     folder = Path(folder)
     _require_frames(trajectory)
+    created = not folder.exists()
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise InputError(str(folder), f"cannot create the folder ({exc.strerror})") from None
     written = []
-    for name, make in (("energy.png", energy_figure), ("speeds.png", speed_figure)):
-        figure = make(trajectory)
-        path = folder / name
-        with replacing(path) as temporary:
-            figure.savefig(temporary, dpi=PLOT_DPI)
-        figure.clear()
-        written.append(path)
+    try:
+        for name, make in (("energy.png", energy_figure), ("speeds.png", speed_figure)):
+            figure = make(trajectory)
+            path = folder / name
+            with replacing(path) as temporary:
+                figure.savefig(temporary, dpi=PLOT_DPI)
+            figure.clear()
+            written.append(path)
+    except InputError:
+        if created and not written:  # a full disk: leave no empty folder behind
+            folder.rmdir()
+        raise
     return written
 
 

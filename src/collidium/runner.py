@@ -13,7 +13,8 @@ from __future__ import annotations
 import math
 import os
 import time as clock
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -99,8 +100,8 @@ class Job:
             if "path" in spec:
                 spec["path"] = _writable(f"observers.{k}.path", spec["path"])
         targets = [str(path) for path in self.files()]
-        if self.out is not None and Path(self.out) != self.trajectory:
-            targets.append(self.out)  # .xyz output beside its staging .gsd
+        if self.staged:
+            targets.append(str(self.out))  # .xyz output beside its staging .gsd
         if self.checkpoint is not None:
             targets.append(self.checkpoint)
         if len(set(targets)) < len(targets):
@@ -118,6 +119,11 @@ class Job:
             return None
         out = Path(self.out)
         return out if out.suffix == ".gsd" else out.with_name(f".{out.name}.gsd")
+
+    @property
+    def staged(self) -> bool:
+        """Whether frames go to a hidden GSD file first (.xyz output, converted at the end)."""
+        return self.out is not None and self.trajectory != Path(self.out)
 
     def files(self) -> list[Path]:
         """Every trajectory the run writes (its own and the scenario file's)."""
@@ -247,22 +253,37 @@ def execute(sim: Simulation, job: Job, progress: bool = False) -> dict[str, Any]
         if job.checkpoint is not None and job.checkpoint_every is not None:
             sim.observers.append(CheckpointWriter(job.checkpoint, job.checkpoint_every, job, drift))
     start = clock.perf_counter()
-    try:
-        sim.run(steps=remaining, progress=progress)
-    finally:  # this run's trajectory and any a scenario file asked for
-        for observer in sim.observers:
-            if isinstance(observer, GSDWriter):
-                observer.close()
+    with _staging_named_as_out(job):
+        try:
+            sim.run(steps=remaining, progress=progress)
+        finally:  # this run's trajectory and any a scenario file asked for
+            for observer in sim.observers:
+                if isinstance(observer, GSDWriter):
+                    observer.close()
     wall = clock.perf_counter() - start
     if job.checkpoint is not None and remaining > 0:
         save(sim, job, drift)
     job.max_rel_drift = max(job.max_rel_drift, drift.max_rel_drift)
     trajectory = job.trajectory
-    staged = job.out is not None and trajectory is not None and trajectory != Path(job.out)
-    if staged and trajectory is not None and trajectory.exists():
+    if job.staged and trajectory is not None and trajectory.exists():
         write_xyz(read_trajectory(trajectory), str(job.out))
         trajectory.unlink()
     return summarise(sim, job, thermo, rate, wall, reported)
+
+
+@contextmanager
+def _staging_named_as_out(job: Job) -> Iterator[None]:
+    """Name ``--out`` in a failed write of the GSD file that stages .xyz output (a full disk),
+    and remove that file unless a checkpoint may resume it."""
+    try:
+        yield
+    except InputError as exc:
+        trajectory = job.trajectory
+        if not job.staged or trajectory is None or exc.field != str(trajectory):
+            raise
+        if job.checkpoint is None:
+            trajectory.unlink(missing_ok=True)
+        raise InputError(str(job.out), exc.reason) from None
 
 
 def summarise(

@@ -84,11 +84,12 @@ def test_save_writes_nothing_partial_and_replaces_atomically(tmp_path, monkeypat
     before = target.read_bytes()
 
     def fail(*args, **kwargs):
-        raise OSError("disk full")
+        raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(np, "savez", fail)
-    with pytest.raises(OSError):
+    with pytest.raises(InputError, match="cannot write: No space left on device") as caught:
         sim.run(steps=3).save(target)
+    assert caught.value.field == str(target)
     assert target.read_bytes() == before
     assert [p.name for p in tmp_path.iterdir()] == ["x.ckpt"]
 

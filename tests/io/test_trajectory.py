@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 import subprocess
 import sys
@@ -15,11 +16,13 @@ import pytest
 import collidium as cd
 from collidium.errors import InputError
 from collidium.io import describe_file
+from collidium.io import trajectory as trajectory_module
 from collidium.io.trajectory import (
     TYPES,
     GSDWriter,
     keep_frames_through,
     read_trajectory,
+    unwritten_bytes,
     write_xyz,
 )
 
@@ -164,8 +167,11 @@ def test_killed_writer_leaves_every_flushed_frame(tmp_path):
         lambda data: b"",
     ],
 )
-def test_damaged_file_gives_one_clear_error(tmp_path, damage):
+@pytest.mark.parametrize("reader", ["mapped", "pure Python"])
+def test_damaged_file_gives_one_clear_error(tmp_path, monkeypatch, damage, reader):
     _, path = record(tmp_path)
+    if reader == "pure Python":  # the reader for files on a full disk
+        monkeypatch.setattr(trajectory_module, "_mapping_may_fault", lambda _: True)
     path.write_bytes(damage(path.read_bytes()))
     with pytest.raises(InputError) as caught:
         read_trajectory(path)
@@ -204,3 +210,67 @@ def test_the_piston_is_logged_and_drawn_where_it_was(tmp_path):
     assert (position[-1], trajectory.log["piston/work"][-1, 0]) == (piston.position, piston.work)
     line = trajectory.vessel.piston_line(float(position[-1]))
     np.testing.assert_array_equal(line, [[-10.0, position[-1]], [10.0, position[-1]]])
+
+
+def full_disk(monkeypatch):
+    """Make every disk report no free space."""
+    disk = os.statvfs(os.curdir)
+    full = os.statvfs_result((*disk[:4], 0, *disk[5:]))  # f_bavail = 0
+    monkeypatch.setattr(trajectory_module.os, "statvfs", lambda _: full)
+
+
+def test_holes_are_counted_as_unwritten_bytes(tmp_path):
+    path = tmp_path / "sparse"
+    with path.open("wb") as stream:
+        stream.write(b"x" * 4096)
+        stream.truncate(1 << 22)  # 4 MiB, all but the first block never written
+    holes = unwritten_bytes(path)
+    assert (1 << 22) - (1 << 20) <= holes <= (1 << 22) - 4096
+    path.write_bytes(b"x" * 8192)
+    assert unwritten_bytes(path) == 0
+
+
+def test_a_full_disk_reads_without_the_memory_map(tmp_path, monkeypatch):
+    """gsd maps a file's index, which it grows by extending the file (a hole); on a full tmpfs,
+    reading a mapped hole kills the process (SIGBUS). With no room for the holes, the file is
+    read through gsd's pure-Python reader instead, to the same arrays."""
+    _, path = record(tmp_path, preset="gas", every=1, steps=150, n=20)
+    assert unwritten_bytes(path) > 0  # the index has grown
+    mapped = read_trajectory(path)
+
+    def refuse_to_map(*_args, **_kwargs):
+        raise AssertionError("gsd's memory-mapped reader was used on a full disk")
+
+    full_disk(monkeypatch)
+    monkeypatch.setattr(gsd.hoomd, "open", refuse_to_map)
+    read = read_trajectory(path)
+    for name in ("step", "time", "position", "velocity", "mass", "radius", "charge"):
+        np.testing.assert_array_equal(getattr(read, name), getattr(mapped, name))
+    assert read.log.keys() == mapped.log.keys()
+    np.testing.assert_array_equal(read.log["energy/total"], mapped.log["energy/total"])
+
+
+def test_appending_on_a_full_disk_is_refused_and_leaves_the_file(tmp_path, monkeypatch):
+    sim, path = record(tmp_path, preset="gas", every=1, steps=150, n=20)
+    before = path.read_bytes()
+    full_disk(monkeypatch)
+    with pytest.raises(InputError, match="cannot append: 0 bytes free") as caught:
+        GSDWriter(path, 10, append=True).attach(sim)
+    assert caught.value.field == str(path)
+    assert path.read_bytes() == before
+
+
+def test_a_write_that_fails_names_the_file(tmp_path, monkeypatch):
+    """A full disk (ENOSPC) while frames are flushed: one `InputError` naming the file."""
+    sim = cd.load("gas")
+    path = tmp_path / "run.gsd"
+    writer = GSDWriter(path, 1)
+    writer.attach(sim)
+
+    def no_space():
+        raise OSError(28, "No space left on device", str(path))
+
+    monkeypatch.setattr(writer._file, "flush", no_space)
+    with pytest.raises(InputError, match="cannot write: No space left on device") as caught:
+        writer.flush()
+    assert caught.value.field == str(path)

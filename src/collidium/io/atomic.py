@@ -22,7 +22,8 @@ def replacing(path: str | Path) -> Iterator[Path]:
     Raises
     ------
     InputError
-        If ``path`` names a folder, or its folder does not exist or cannot be written.
+        If ``path`` names a folder, its folder does not exist or cannot be written, or writing
+        fails (a full disk).
     """
     path = Path(path)
     if not path.name or path.is_dir():
@@ -36,6 +37,9 @@ def replacing(path: str | Path) -> Iterator[Path]:
     try:
         yield temporary
         os.replace(temporary, path)
+    except OSError as exc:  # a full or read-only disk, most often
+        temporary.unlink(missing_ok=True)
+        raise InputError(str(path), f"cannot write: {exc.strerror or exc}") from None
     except BaseException:
         temporary.unlink(missing_ok=True)
         raise

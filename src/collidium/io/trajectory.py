@@ -11,8 +11,10 @@ does by default; checkpoints (`collidium.io.checkpoint`) keep the exact state.
 from __future__ import annotations
 
 import json
+import os
 import time as clock
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -29,6 +31,10 @@ if TYPE_CHECKING:
     import gsd.hoomd
 
     from collidium.simulation import Simulation
+
+#: Free bytes a disk must have beyond a GSD file's holes for the file to be read through gsd's
+#: memory map (see `_mapping_may_fault`).
+MAPPING_MARGIN = 1 << 20
 
 #: Particle types by the sign of the charge (OVITO colours by type).
 TYPES = ("neutral", "positive", "negative")
@@ -179,10 +185,16 @@ class GSDWriter:
 
         if self._file is not None:
             return True
+        if self.append and self.path.is_file() and _mapping_may_fault(self.path):
+            raise InputError(str(self.path), f"cannot append: {_free_space(self.path)} on its disk")
+        created = not self.path.exists()
         try:
             self._file = gsd.hoomd.open(self.path, "r+" if self.append else "w")
         except (OSError, RuntimeError) as exc:
-            raise InputError(str(self.path), f"cannot write a GSD file: {exc}") from None
+            if created:  # leave no empty file behind
+                self.path.unlink(missing_ok=True)
+            reason = getattr(exc, "strerror", None) or str(exc)
+            raise InputError(str(self.path), f"cannot write a GSD file: {reason}") from None
         if self.append and len(self._file):
             self._last_step = int(self._file[-1].configuration.step)
             return False
@@ -193,7 +205,8 @@ class GSDWriter:
         self._open()
         if self._file is None or sim.steps == self._last_step:
             return
-        self._file.append(frame_of(sim))
+        with self._writing():
+            self._file.append(frame_of(sim))
         self._last_step = sim.steps
         self.frames_written += 1
         if self._unflushed_since is None:
@@ -204,16 +217,26 @@ class GSDWriter:
     def flush(self) -> None:
         """Write the buffered frames to disk now."""
         if self._file is not None:
-            self._file.flush()
+            with self._writing():
+                self._file.flush()
         self._unflushed_since = None
 
     def close(self) -> None:
         """Flush and close the file."""
-        if self._file is not None:
-            self._file.close()
-            self._file = None
-            self.append = True  # reopening continues the same file
+        file, self._file = self._file, None
         self._unflushed_since = None
+        if file is not None:
+            self.append = True  # reopening continues the same file
+            with self._writing():
+                file.close()
+
+    @contextmanager
+    def _writing(self) -> Iterator[None]:
+        """Turn a failed write (a full disk) into an `InputError` naming the file."""
+        try:
+            yield
+        except OSError as exc:
+            raise InputError(str(self.path), f"cannot write: {exc.strerror or exc}") from None
 
     def __enter__(self) -> GSDWriter:
         return self
@@ -278,13 +301,63 @@ class Trajectory:
         return int(self.mass.shape[0])
 
 
+def unwritten_bytes(path: Path) -> int:
+    """Bytes of ``path`` in holes: ranges never written, which read back as zeros.
+
+    GSD files have them: the library grows its index by extending the file. 0 where the
+    filesystem does not report holes.
+    """
+    hole = getattr(os, "SEEK_HOLE", None)
+    data = getattr(os, "SEEK_DATA", None)
+    if hole is None or data is None:
+        return 0
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        size, start, total = os.fstat(fd).st_size, 0, 0
+        while start < size:
+            end = os.lseek(fd, start, hole)
+            try:
+                start = os.lseek(fd, end, data)
+            except OSError:  # no data after this hole
+                start = size
+            total += start - end
+        return total
+    except OSError:
+        return 0
+    finally:
+        os.close(fd)
+
+
+def _mapping_may_fault(path: Path) -> bool:
+    """Whether gsd's memory map of ``path`` could stop the process with SIGBUS.
+
+    A mapped hole is backed by a new page when it is read on some filesystems (tmpfs); on a
+    disk without room for the holes, that read kills the process instead of raising.
+    """
+    holes = unwritten_bytes(path)
+    if holes == 0:
+        return False
+    disk = os.statvfs(path)
+    return disk.f_bavail * disk.f_frsize < holes + MAPPING_MARGIN
+
+
+def _free_space(path: Path) -> str:
+    """The free space on ``path``'s disk, in words."""
+    disk = os.statvfs(path)
+    return f"{disk.f_bavail * disk.f_frsize} bytes free"
+
+
 def _open_for_reading(path: Path) -> gsd.hoomd.HOOMDTrajectory:
     import gsd.hoomd
+    import gsd.pygsd
 
     if not path.is_file():
         raise InputError(str(path), "no such file")
     try:
-        return gsd.hoomd.open(path, "r")
+        if not _mapping_may_fault(path):
+            return gsd.hoomd.open(path, "r")
+        # gsd's pure-Python reader reads with read(), which gives holes as zeros without room.
+        return gsd.hoomd.HOOMDTrajectory(gsd.pygsd.GSDFile(path.open("rb")))
     except Exception as exc:  # gsd raises RuntimeError, OSError or ValueError on bad files
         raise InputError(str(path), f"not a readable GSD trajectory ({exc})") from None
 
