@@ -154,7 +154,9 @@ def test_an_energy_drift_past_the_limit_is_marked_and_said(page):
     assert page.inner_text("#message").startswith("energy: the total energy drifted by")
     assert abs(readout(page, "drift")) > 1e-3
     page.select_option("#preset", "gas")  # a new scene starts unmarked
-    page.wait_for_function("document.querySelector('#readout-n').dataset.value === '200'")
+    page.wait_for_function("window.collidiumViewer.scene.preset === 'gas'")
+    page.evaluate("window.statsBefore = window.collidiumViewer.stats")
+    page.wait_for_function("window.collidiumViewer.stats !== window.statsBefore")  # the gas's
     assert "warning" not in page.get_attribute("#readout-drift", "class")
 
 
