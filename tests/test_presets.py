@@ -26,6 +26,7 @@ SECTIONS = {
     "pool-break": "4.1.1",
     "charged-no-collisions": "4.2.1",
     "circle-gas": "5",
+    "hard-disks": "5",
     "pi-blocks": "5",
     "brownian": "5",
     "heat-flow": "5",
@@ -83,7 +84,7 @@ def test_default_vessel_and_run(name):
     assert scenario.run.dt == 0.01
     assert scenario.run.collisions == "exact"
     times = {"pool-break": 60.0, "heat-flow": 60.0, "brownian": 300.0, "granular": 30.0,
-             "piston": 60.0, "effusion": 200.0}  # fmt: skip
+             "piston": 60.0, "effusion": 200.0, "hard-disks": 50.0}  # fmt: skip
     assert scenario.run.time == times.get(name, 10.0)
     if name == "circle-gas":
         assert scenario.to_dict()["vessel"] == {"shape": "circle", "radius": 11.3}
@@ -96,6 +97,12 @@ def test_default_vessel_and_run(name):
         assert scenario.to_dict()["vessel"] == {"shape": "box", "width": 60.0, "height": 60.0,
                                                 "boundary": "periodic"}  # fmt: skip
         assert scenario.run.restitution == 0.9
+        return
+    if name == "hard-disks":  # a periodic box that a 20 x 20 hexagonal lattice fills exactly
+        spacing = 0.5 * np.sqrt(2 * np.pi / (np.sqrt(3) * 0.3))
+        assert scenario.vessel.boundary == "periodic"
+        assert scenario.vessel.width == pytest.approx(20 * spacing, rel=1e-15)
+        assert scenario.vessel.height == pytest.approx(10 * np.sqrt(3) * spacing, rel=1e-15)
         return
     assert scenario.vessel.boundary == "reflecting"
     size = {"pool-break": (40.0, 20.0), "heat-flow": (40.0, 10.0), "piston": (20.0, 40.0),
@@ -429,3 +436,39 @@ def test_effusion_follows_grahams_law_and_the_lighter_escapes_faster():
         speed = math.sqrt(2 * kT / (math.pi * mass))
         expected = theory.effusion_rate(speed, 4.0 - 2 * 0.005, chamber)
         assert abs(effusion.rates[k] - expected) < 3 * effusion.rate_errors[k]
+
+
+@pytest.mark.parametrize("packing", [0.05, 0.3, 0.65, 0.9])
+def test_hard_disks_start_on_a_lattice_that_fills_the_periodic_box(packing):
+    """Every disk's six neighbours, across the box's seams too, sit one lattice spacing away:
+    the packing is exact and no pair overlaps."""
+    sim = preset("hard-disks", packing=packing).build()
+    p, box = sim.particles, sim.container
+    assert p.n == 400
+    assert p.n * np.pi * 0.25 / (box.width * box.height) == pytest.approx(packing, rel=1e-12)
+    separation = p.position[:, None, :] - p.position[None, :, :]
+    separation -= np.array([box.width, box.height]) * np.round(
+        separation / np.array([box.width, box.height])
+    )
+    distance = np.hypot(separation[..., 0], separation[..., 1]) + np.diag(np.full(p.n, np.inf))
+    spacing = 0.5 * np.sqrt(2 * np.pi / (np.sqrt(3) * packing))
+    nearest = np.sort(distance, axis=1)[:, :6]
+    np.testing.assert_allclose(nearest, spacing, rtol=1e-9)
+    assert (distance >= 1.0).all()  # touching at most, at the densest packing
+
+
+def test_hard_disks_follow_hendersons_equation_of_state():
+    """The lattice melts at packing 0.3; Z from the collision virial over 200 s after 20 s
+    matches Henderson's formula within 3 standard errors plus Henderson's own error (its distance
+    from the virial series)."""
+    from collidium.observers import Thermo
+    from collidium.theory import hard_disk_compressibility, hard_disk_virial_series
+
+    sim = preset("hard-disks", packing=0.3).build().run(time=20.0)
+    thermo = Thermo()
+    sim.observers.append(thermo)
+    sim.run(time=200.0)
+    series = hard_disk_virial_series(0.3)
+    henderson = hard_disk_compressibility(0.3)
+    z, error = thermo.compressibility(), thermo.compressibility_error()
+    assert abs(z - henderson) < 3 * error + abs(henderson - series)

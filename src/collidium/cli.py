@@ -383,6 +383,10 @@ def _print_summary(summary: dict[str, Any]) -> None:
         ("temperature kT", _number(summary["temperature"], "J")),
         ("wall pressure", _number(pressure["wall"], "N/m", pressure["wall_error"])),
         ("virial pressure", _number(pressure["virial"], "N/m", pressure["virial_error"])),
+        (
+            "compressibility Z = PA/NkT",
+            _number(summary["compressibility"], "", summary["compressibility_error"]),
+        ),
         ("Maxwell-Boltzmann KS p-value", _number(summary["ks_pvalue"], "")),
         ("escaped", f"{summary['escaped']}"),
         *_piston_rows(summary.get("piston")),

@@ -238,7 +238,7 @@ def hexagonal_positions(vessel: Vessel, radius: float, packing: float) -> FloatA
     ndarray, shape (N, 2)
         Centres in m, row by row.
     """
-    spacing = radius * math.sqrt(2.0 * math.pi / (math.sqrt(3.0) * packing))
+    spacing = lattice_spacing(radius, packing)
     (x0, y0), (x1, y1) = vessel.bounds
     rows = np.arange(y0, y1, spacing * math.sqrt(3.0) / 2.0)
     columns = np.arange(x0, x1, spacing)
@@ -249,6 +249,34 @@ def hexagonal_positions(vessel: Vessel, radius: float, packing: float) -> FloatA
     inside = np.ones(len(centres), dtype=bool)
     inside[vessel.outside(centres, np.full(len(centres), radius * (1.0 + 1e-6)))] = False
     return centres[inside]
+
+
+def lattice_spacing(radius: float, packing: float) -> float:
+    """Distance between neighbouring centres (m) of a hexagonal lattice of disks of ``radius`` (m)
+    covering the share ``packing`` of the plane: each disk has a cell of ``sqrt(3)/2 a^2``."""
+    return radius * math.sqrt(2.0 * math.pi / (math.sqrt(3.0) * packing))
+
+
+def hexagonal_block(
+    columns: int, rows: int, radius: float, packing: float, low: tuple[float, float]
+) -> FloatArray:
+    """Centres of ``columns x rows`` disks on a hexagonal lattice at ``packing``, its block
+    ``columns a`` wide and ``rows a sqrt(3)/2`` high from the corner ``low`` (m), ``a`` the
+    `lattice_spacing`; odd rows shifted by ``a/2``. With ``rows`` even the block tiles the plane:
+    a periodic box of its size holds a perfect lattice.
+
+    Returns
+    -------
+    ndarray, shape (columns * rows, 2)
+        Centres in m, row by row.
+    """
+    spacing = lattice_spacing(radius, packing)
+    height = spacing * math.sqrt(3.0) / 2.0
+    row = np.repeat(np.arange(rows), columns)
+    column = np.tile(np.arange(columns), rows)
+    x = low[0] + (column + 0.25 + 0.5 * (row % 2)) * spacing
+    y = low[1] + (row + 0.5) * height
+    return np.column_stack([x, y]).astype(np.float64)
 
 
 def uniform_velocities(n: int, speed: float, rng: np.random.Generator) -> FloatArray:

@@ -15,11 +15,13 @@ groups, from the shared values it needs and its own knobs (``n``, ``speed``, ``c
 from __future__ import annotations
 
 import inspect
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from collidium.errors import InputError
+from collidium.initial import lattice_spacing
 from collidium.integrators import DEFAULT_TOLERANCE
 
 if TYPE_CHECKING:
@@ -127,6 +129,7 @@ def _scenario(name: str, values: dict[str, Any]) -> Scenario:
             "description": title,
             "seed": values["seed"],
             "vessel": _vessel(entry, values)
+            | parts.get("vessel", {})
             | {key: parts[key] for key in ("walls", "partitions") if key in parts},
             "run": {
                 key: values[key] for key in ("dt", "time", "collisions", "integrator", "tolerance")
@@ -292,6 +295,46 @@ def circle_gas(mass: float, radius: float, *, n: int = 200, speed: float = 10.0)
     angular momentum about the centre as well as the energy (the seed's future work: other
     shapes of vessel)."""
     return gas(mass, radius, n=n, speed=speed)
+
+
+@_preset(
+    "hard-disks",
+    "5",
+    "a hard-disk fluid at a packing fraction in a periodic box: its pressure, Z(eta)",
+    common=tuple(key for key in _NEUTRAL if key not in ("width", "height")),
+    title="{columns} x {rows} hard disks at packing {packing:g} in a periodic box",
+    radius=0.5,
+    time=50.0,
+)
+def hard_disks(
+    mass: float,
+    radius: float,
+    *,
+    packing: float = 0.3,
+    columns: int = 20,
+    rows: int = 20,
+    speed: float = 1.0,
+) -> dict[str, Any]:
+    """``columns x rows`` disks start on a hexagonal lattice at ``packing`` that fills a periodic
+    box exactly (``rows`` even), velocity components uniform in ``[-speed, speed]`` m/s (kT =
+    m speed^2 / 3); the lattice melts below a packing of about 0.70. The run's virial pressure
+    gives the equation of state ``Z = P A / (N kT)`` (``compressibility`` in the summary), to set
+    against Henderson's formula (`collidium.theory.hard_disk_compressibility`); the seed's future
+    work asks for exactly this curve."""
+    if rows % 2:
+        raise InputError(
+            "rows", f"must be even, so that the lattice fills the periodic box; got {rows}"
+        )
+    if not 0.0 < packing <= 0.9069:
+        raise InputError("packing", f"must be in (0, 0.9069], got {packing!r}")
+    spacing = lattice_spacing(radius, packing)
+    width, height = columns * spacing, rows * spacing * math.sqrt(3.0) / 2.0
+    lattice = {"kind": "lattice", "columns": columns, "rows": rows, "packing": packing,
+               "radius": radius, "mass": mass, "speed": speed}  # fmt: skip
+    return {
+        "vessel": {"width": width, "height": height, "boundary": "periodic"},
+        "particles": [lattice],
+    }
 
 
 #: Largest ``digits`` of pi-blocks: double precision gives every count up to 8 (314159265

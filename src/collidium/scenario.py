@@ -45,7 +45,7 @@ A scenario file::
     softening = 0.0               # m
 
     [[particles]]                 # groups, concatenated in order
-    kind = "random"               # "explicit" | "random" | "rack"
+    kind = "random"               # "explicit" | "random" | "rack" | "lattice"
     n = 200
     speed = 10.0                  # velocity components uniform in [-speed, speed], m/s
 
@@ -87,7 +87,13 @@ from pydantic import (
 
 from collidium.errors import InputError
 from collidium.forces import DEFAULT_THETA, Coulomb
-from collidium.initial import balanced_charges, random_positions, rhombus_rack, uniform_velocities
+from collidium.initial import (
+    balanced_charges,
+    hexagonal_block,
+    random_positions,
+    rhombus_rack,
+    uniform_velocities,
+)
 from collidium.integrators import DEFAULT_TOLERANCE
 from collidium.io.trajectory import GSDWriter
 from collidium.observers import (
@@ -637,7 +643,47 @@ class RackGroup(_Model):
         )  # fmt: skip
 
 
-Group = Annotated[ExplicitGroup | RandomGroup | RackGroup, Field(discriminator="kind")]
+class LatticeGroup(_Model):
+    """``columns x rows`` equal disks on a hexagonal lattice covering the share ``packing`` of
+    the plane (`collidium.initial.hexagonal_block`), from the corner ``origin`` (the vessel's
+    lower-left corner by default), velocity components uniform in ``[-speed, speed]``: the start
+    of a dense fluid, which random placement cannot reach past a packing of about 0.55."""
+
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    kind: Literal["lattice"] = "lattice"
+    columns: Annotated[int, Field(ge=1, le=MAX_GROUP_SIZE)]
+    rows: Annotated[int, Field(ge=1, le=MAX_GROUP_SIZE)]
+    packing: Annotated[float, Field(gt=0.0, le=0.9069)]
+    radius: Positive = 0.5
+    mass: Positive = 1.0
+    speed: NonNegative = 0.0
+    charge: Finite = 0.0
+    origin: Vector | None = None
+
+    @property
+    def count(self) -> int:
+        """Number of particles in the group."""
+        return self.columns * self.rows
+
+    def generate(
+        self, rng: np.random.Generator, vessel: Vessel, existing: GroupState, index: int
+    ) -> GroupState:
+        """The lattice's centres, then velocities drawn from ``rng``."""
+        low = vessel.bounds[0] if self.origin is None else self.origin
+        position = hexagonal_block(
+            self.columns, self.rows, self.radius, self.packing, (float(low[0]), float(low[1]))
+        )
+        full = np.full(self.count, 1.0)
+        return GroupState(
+            position, uniform_velocities(self.count, self.speed, rng), self.mass * full,
+            self.radius * full, self.charge * full,
+        )  # fmt: skip
+
+
+Group = Annotated[
+    ExplicitGroup | RandomGroup | RackGroup | LatticeGroup, Field(discriminator="kind")
+]
 
 #: Model of the vessel table, by its shape, and of a wall's table, by its response (for error
 #: messages).
@@ -654,6 +700,7 @@ _TAGGED: dict[str, type[_Model]] = {
     "explicit": ExplicitGroup,
     "random": RandomGroup,
     "rack": RackGroup,
+    "lattice": LatticeGroup,
     "coulomb": CoulombSpec,
     "energy": EnergySpec,
     "speeds": SpeedsSpec,
@@ -681,7 +728,7 @@ class Scenario(_Model):
         dt, default duration and collision mode.
     forces : list of CoulombSpec
         Forces between particles.
-    particles : list of ExplicitGroup, RandomGroup or RackGroup
+    particles : list of ExplicitGroup, RandomGroup, RackGroup or LatticeGroup
         Particle groups, concatenated in order.
     observers : list of observer specs
         Measurements and writers attached by `build` (``sim.observers``).

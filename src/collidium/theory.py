@@ -77,6 +77,19 @@ def hard_disk_compressibility(packing: float) -> float:
     return (1 + packing**2 / 8) / (1 - packing) ** 2
 
 
+#: Reduced virial coefficients ``b_2 ... b_10`` of hard disks (Clisby and McCoy 2006), in
+#: ``Z = 1 + sum_k b_(k+2) eta^(k+1)``.
+HARD_DISK_VIRIAL_COEFFICIENTS = (
+    2.0, 3.12801775, 4.25785446, 5.33689664, 6.36296, 7.35186, 8.3077, 9.2271, 10.1,
+)  # fmt: skip
+
+
+def hard_disk_virial_series(packing: float) -> float:
+    """``Z`` of the hard-disk fluid from its virial series to the tenth coefficient: a check of
+    `hard_disk_compressibility` (their distance bounds Henderson's error at low packing)."""
+    return 1.0 + sum(b * packing ** (k + 1) for k, b in enumerate(HARD_DISK_VIRIAL_COEFFICIENTS))
+
+
 def contact_value(packing: float) -> float:
     """Pair correlation at contact ``chi`` of the hard-disk fluid, from Henderson's equation of
     state (``Z = 1 + 2 eta chi``): ``chi = (1 - 7 eta / 16) / (1 - eta)^2``."""

@@ -8,7 +8,7 @@ from matplotlib.figure import Figure
 
 import collidium as cd
 from collidium.observers import Thermo
-from collidium.theory import hard_disk_compressibility
+from collidium.theory import hard_disk_compressibility, hard_disk_virial_series
 from conftest import jittered_lattice
 
 
@@ -91,10 +91,6 @@ def test_wall_and_virial_pressure_agree_with_coulomb_forces():
     assert abs(thermo.wall_pressure()["total"] - thermo.virial_pressure()) < 3 * both
 
 
-#: Reduced virial coefficients of hard disks (Clisby and McCoy 2006): Z = 1 + sum b_k eta^k.
-VIRIAL_SERIES = [2.0, 3.12801775, 4.25785446, 5.33689664, 6.36296, 7.35186, 8.3077, 9.2271, 10.1]
-
-
 @pytest.mark.parametrize("packing", [0.05, 0.3])
 def test_hard_disk_equation_of_state(packing):
     """Periodic fluid, no walls: Z from the collision virial matches Henderson's equation of state,
@@ -106,7 +102,7 @@ def test_hard_disk_equation_of_state(packing):
     error = thermo.virial_pressure_error() * thermo.area / (thermo.n * thermo.temperature)
     assert error < 1e-3 * z
     henderson = hard_disk_compressibility(packing)
-    series = 1 + sum(b * packing ** (k + 1) for k, b in enumerate(VIRIAL_SERIES))
+    series = hard_disk_virial_series(packing)
     assert abs(z - henderson) < 3 * error + abs(henderson - series)
     assert np.isnan(thermo.wall_pressure()["total"])
 

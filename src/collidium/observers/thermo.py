@@ -170,6 +170,10 @@ class Thermo(Measurement):
         """``Z = P A_c / (N kT)`` from the virial pressure (1 for an ideal gas)."""
         return self.virial_pressure() * self.area / (self.n * self.temperature)
 
+    def compressibility_error(self) -> float:
+        """Standard error of `compressibility`, from that of the virial pressure."""
+        return self.virial_pressure_error() * self.area / (self.n * self.temperature)
+
     def plot(self, ax: Axes | None = None) -> Axes:
         """Block averages of the wall and virial pressures over time, with the ideal-gas value."""
         ax = new_axes(ax)
@@ -188,7 +192,7 @@ class Thermo(Measurement):
         return ax
 
     def summary(self) -> dict[str, Any]:
-        """Temperature and pressures with their errors."""
+        """Temperature, pressures and the compressibility factor, with their errors."""
         wall = self.wall_pressure()
         return {
             "temperature": self.temperature,
@@ -199,4 +203,6 @@ class Thermo(Measurement):
                 "virial": self.virial_pressure(),
                 "virial_error": self.virial_pressure_error(),
             },
+            "compressibility": self.compressibility(),
+            "compressibility_error": self.compressibility_error(),
         }
