@@ -5,6 +5,8 @@
 >>> sim.run(time=5.0).energy().total  # doctest: +SKIP
 """
 
+from typing import Any
+
 from collidium import observers
 from collidium.errors import InputError, SimulationError
 from collidium.forces import Coulomb
@@ -30,5 +32,15 @@ __all__ = [
     "observers",
     "presets",
     "restore",
+    "sweep",
 ]
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str) -> Any:
+    """``cd.sweep``, imported on first use (it brings pandas and Dask)."""
+    if name == "sweep":
+        from collidium.sweeps import sweep
+
+        return sweep
+    raise AttributeError(f"module 'collidium' has no attribute {name!r}")

@@ -104,24 +104,16 @@ def run_command(
 ) -> int:
     """Run a preset or scenario file and print a summary."""
     from collidium.loading import load_scenario
-    from collidium.runner import Job, execute
-    from collidium.simulation import step_count
+    from collidium.runner import execute, prepare
 
     if time is not None and steps is not None:
         raise InputError("--time", "give --time or --steps, not both")
     values = parse_settings(overrides or [])
     values |= {k: v for k, v in (("dt", dt), ("seed", seed)) if v is not None}
-    spec = load_scenario(scenario, **values)
-    duration = spec.run.time if time is None and steps is None else time
-    count = step_count(duration, steps, spec.run.dt)
-    frame_period = every if every is not None else max(1, round(0.1 / spec.run.dt))
-    job = Job(
-        end_step=count, out=None if out is None else str(out), every=frame_period,
-        checkpoint=None if checkpoint is None else str(checkpoint),
-        checkpoint_every=checkpoint_every, observers=spec.to_dict().get("observers", []),
-        max_drift=max_drift,
+    sim, job = prepare(
+        load_scenario(scenario, **values), time, steps, out, every, checkpoint, checkpoint_every,
+        max_drift,
     )  # fmt: skip
-    sim = spec.build()
     return _report(execute(sim, job, progress=not as_json and sys.stderr.isatty()), job, as_json)
 
 
@@ -224,16 +216,14 @@ def _trajectory_of(
     if source.endswith(".gsd"):
         return read_trajectory(source)
     from collidium.loading import load_scenario
-    from collidium.runner import Job, execute
-    from collidium.simulation import step_count
+    from collidium.runner import execute, prepare
 
-    spec = load_scenario(source, **overrides)
-    count = step_count(spec.run.time if time is None else time, None, spec.run.dt)
     with tempfile.TemporaryDirectory() as folder:
         recording = Path(folder) / "run.gsd"
-        period = every if every is not None else max(1, count // 200)
-        execute(spec.build(), Job(end_step=count, out=str(recording), every=period),
-                progress=sys.stderr.isatty())  # fmt: skip
+        sim, job = prepare(load_scenario(source, **overrides), time, out=recording, every=every)
+        if every is None:  # some 200 frames
+            job.every = max(1, job.end_step // 200)
+        execute(sim, job, progress=sys.stderr.isatty())
         return read_trajectory(recording)
 
 
@@ -321,6 +311,87 @@ def view_command(
     serve(create_app(lambda: ViewerSession(spec, preset=name, overrides=shown), hosts=hosts), sock)
 
 
+@app.command("sweep")
+def sweep_command(
+    scenario: Annotated[str, typer.Argument(help="Preset name or scenario .toml file.")],
+    grid: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--grid",
+            metavar="KEY=V1,V2,...",
+            help="A parameter and its values (or start:stop:count). Repeatable: every "
+            "combination runs.",
+        ),
+    ] = None,
+    seeds: Annotated[int, typer.Option("--seeds", help="Seeds per point (1..N).")] = 1,
+    time: Annotated[float | None, typer.Option("--time", help="Duration of each run in s.")] = None,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            "--out", help="The table (.parquet or .csv); a sweep run again skips the runs it holds."
+        ),
+    ] = None,
+    measure: Annotated[
+        list[str] | None,
+        typer.Option("--measure", help="Keep only these quantities (pressure, temperature...)."),
+    ] = None,
+    trajectories: Annotated[
+        Path | None, typer.Option("--trajectories", help="A folder for each run's .gsd file.")
+    ] = None,
+    scheduler: Annotated[
+        str | None, typer.Option("--scheduler", help="A Dask scheduler's address.")
+    ] = None,
+    workers: Annotated[
+        int | None, typer.Option("--workers", help="Local workers (default: one per core).")
+    ] = None,
+    plot: Annotated[
+        Path | None,
+        typer.Option("--plot", help="Draw --y against the first grid key, with errors (.png)."),
+    ] = None,
+    y: Annotated[str, typer.Option("--y", help="The quantity --plot draws.")] = "compressibility",
+) -> int:
+    """Run a scenario over a grid of parameters and seeds on Dask: one row per run."""  # fmt: skip
+    from collidium.sweeps import sweep
+
+    values = parse_grid(grid or [])
+    if not values:
+        raise InputError("--grid", "give at least one KEY=V1,V2,...")
+    if plot is not None and plot.suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise InputError("--plot", f"must end in .png, .svg or .pdf, got {plot}")
+    table = sweep(
+        scenario, values, seeds=seeds, time=time, measure=measure, out=out,
+        trajectories=trajectories, scheduler=scheduler, workers=workers,
+        progress=sys.stderr.isatty(),
+    )  # fmt: skip
+    failed = table[table["status"] != "ok"]
+    for _, row in failed.iterrows():
+        _warn(f"run {row['run']} ({_point(row, values)}, seed {row['seed']}) failed: "
+              f"{row['error']}")  # fmt: skip
+    if plot is not None:
+        _draw_sweep(table, next(iter(values)), y, plot)
+    where = f"; {out}" if out is not None else ""
+    typer.echo(f"{len(table)} runs: {len(table) - len(failed)} ok, {len(failed)} failed{where}")
+    if out is None:
+        typer.echo(table.to_string(index=False))
+    return 0
+
+
+def _point(row: Any, grid: dict[str, list[Any]]) -> str:
+    return ", ".join(f"{key}={row[key]}" for key in grid)
+
+
+def _draw_sweep(table: Any, x: str, y: str, path: Path) -> None:
+    from matplotlib.figure import Figure
+
+    from collidium.io.atomic import replacing
+    from collidium.sweeps import plot
+
+    figure = Figure(figsize=(6, 4), layout="constrained")
+    plot(table, x, y, figure.add_subplot())
+    with replacing(path) as temporary:
+        figure.savefig(temporary, dpi=150)
+
+
 def _warn(line: str) -> None:
     sys.stderr.write(f"warning: {line}\n")
 
@@ -337,16 +408,66 @@ def parse_settings(items: Sequence[str]) -> dict[str, Any]:
         key = key.strip()
         if not sep or not key:
             raise InputError("--set", f"expected KEY=VALUE, got {item!r}")
-        text = text.strip()
-        try:
-            values[key] = tomllib.loads(f"value = {text}")["value"]
-        except tomllib.TOMLDecodeError:
-            values[key] = text
-        except ValueError:  # Python refuses to read an integer of over 4300 digits
-            raise InputError(key, "a number with too many digits") from None
-        except RecursionError:
-            raise InputError(key, "arrays or tables nested too deeply") from None
+        values[key] = _toml_value(key, text.strip())
     return values
+
+
+def _toml_value(key: str, text: str) -> Any:
+    """``text`` read as a TOML value; kept as a string if it is not one (a bare word)."""
+    try:
+        return tomllib.loads(f"value = {text}")["value"]
+    except tomllib.TOMLDecodeError:
+        return text
+    except ValueError:  # Python refuses to read an integer of over 4300 digits
+        raise InputError(key, "a number with too many digits") from None
+    except RecursionError:
+        raise InputError(key, "arrays or tables nested too deeply") from None
+
+
+def parse_grid(items: Sequence[str]) -> dict[str, list[Any]]:
+    """``["packing=0.1,0.2", "n=100:400:4"]`` -> ``{"packing": [0.1, 0.2], "n": [100, 200, 300,
+    400]}``: values split at the commas outside brackets, each read as by `parse_settings`;
+    ``start:stop:count`` is ``count`` evenly spaced values from ``start`` to ``stop``
+    (whole numbers if all three are)."""
+    grid: dict[str, list[Any]] = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise InputError("--grid", f"expected KEY=VALUE,VALUE,..., got {item!r}")
+        if key in grid:
+            raise InputError("--grid", f"{key} is given twice")
+        parts = [part.strip() for part in _split_top_level(text) if part.strip()]
+        grid[key] = [v for part in parts for v in _grid_values(key, part)]
+    return grid
+
+
+def _split_top_level(text: str) -> list[str]:
+    """``"1,[2,3],4"`` -> ``["1", "[2,3]", "4"]``."""
+    parts, depth, start = [], 0, 0
+    for k, char in enumerate(text):
+        depth += (char in "[{") - (char in "]}")
+        if char == "," and depth == 0:
+            parts.append(text[start:k])
+            start = k + 1
+    return [*parts, text[start:]]
+
+
+def _grid_values(key: str, text: str) -> list[Any]:
+    """One grid entry: a TOML value, or ``start:stop:count``."""
+    pieces = text.split(":")
+    if len(pieces) != 3:
+        return [_toml_value(key, text)]
+    start, stop, count = (_toml_value(key, piece) for piece in pieces)
+    numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (start, stop))
+    if not numbers or isinstance(count, bool) or not isinstance(count, int) or count < 1:
+        raise InputError(key, f"a range is start:stop:count with count >= 1, got {text!r}")
+    if count == 1:
+        return [start]
+    values = [start + (stop - start) * k / (count - 1) for k in range(count)]
+    if isinstance(start, int) and isinstance(stop, int) and (stop - start) % (count - 1) == 0:
+        return [round(v) for v in values]
+    return [round(v, 12) for v in values]  # 0.05:0.65:13 gives 0.1, not 0.10000000000000002
 
 
 def write_atomically(path: Path, text: str) -> None:

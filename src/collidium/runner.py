@@ -32,8 +32,8 @@ from collidium.observers import (
 )
 from collidium.observers.energy import DRIFT_WARNING, conserved_energy
 from collidium.observers.energy import drift_warning as drift_warning_line
-from collidium.scenario import build_observers
-from collidium.simulation import Simulation, restore_with_meta
+from collidium.scenario import Scenario, build_observers
+from collidium.simulation import Simulation, restore_with_meta, step_count
 
 #: Trajectory formats by file suffix.
 OUTPUT_SUFFIXES = (".gsd", ".xyz")
@@ -229,6 +229,34 @@ def resume(path: str | Path) -> tuple[Simulation, Job]:
             observer.append = True
     sim.observers += observers
     return sim, job
+
+
+def prepare(
+    spec: Scenario,
+    time: float | None = None,
+    steps: int | None = None,
+    out: str | Path | None = None,
+    every: int | None = None,
+    checkpoint: str | Path | None = None,
+    checkpoint_every: int | None = None,
+    max_drift: float | None = None,
+) -> tuple[Simulation, Job]:
+    """The simulation a scenario builds and the job of running it, as `collidium run` does.
+
+    The run lasts ``time`` s or ``steps`` steps (the scenario's ``run.time`` if neither); frames
+    go to ``out`` every ``every`` steps (0.1 s by default).
+    """
+    if time is not None and steps is not None:
+        raise InputError("--time", "give --time or --steps, not both")
+    duration = spec.run.time if time is None and steps is None else time
+    job = Job(
+        end_step=step_count(duration, steps, spec.run.dt), out=None if out is None else str(out),
+        every=every if every is not None else max(1, round(0.1 / spec.run.dt)),
+        checkpoint=None if checkpoint is None else str(checkpoint),
+        checkpoint_every=checkpoint_every, observers=spec.to_dict().get("observers", []),
+        max_drift=max_drift,
+    )  # fmt: skip
+    return spec.build(), job
 
 
 def execute(sim: Simulation, job: Job, progress: bool = False) -> dict[str, Any]:
