@@ -156,3 +156,15 @@ def test_plan_refuses_bad_seeds_and_names_the_field():
     assert len({run.key for run in plan("gas", {"n": [20, 30]}, 3)}) == 6
     # The keys differ between runs; the same run gets the same key in another sweep.
     assert plan("gas", {"n": [20]}, 1)[0].key == plan("gas", {"n": [20, 30]}, 1)[0].key
+
+
+def test_each_run_writes_its_trajectory_and_a_scheduler_address_is_used(tmp_path, two_workers):
+    from collidium.io.trajectory import read_trajectory
+
+    address = two_workers.scheduler.address
+    table = sweep("gas", {"n": [20, 30]}, time=1.0, trajectories=tmp_path / "runs",
+                  scheduler=address)  # fmt: skip
+    assert (table["status"] == "ok").all()
+    for run, n in table[["run", "n"]].values:
+        trajectory = read_trajectory(tmp_path / "runs" / f"run-{run:05d}.gsd")
+        assert trajectory.n == n and trajectory.frames == 11  # every 0.1 s, both ends

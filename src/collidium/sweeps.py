@@ -361,10 +361,11 @@ def _progress_bar(show: bool, total: int) -> Iterator[Callable[[int, int, int], 
     columns = (TextColumn("runs"), BarColumn(), MofNCompleteColumn(),
                TextColumn("{task.description}"))  # fmt: skip
     with Progress(*columns, transient=True) as bar:
-        task = bar.add_task(f"0 running, 0 failed of {total}", total=total)
+        task = bar.add_task(f"{total} running or queued, 0 failed", total=total)
 
         def advance(done: int, running: int, failed: int) -> None:
-            bar.update(task, completed=done, description=f"{running} to go, {failed} failed")
+            bar.update(task, completed=done,
+                       description=f"{running} running or queued, {failed} failed")  # fmt: skip
 
         yield advance
 
