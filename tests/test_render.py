@@ -293,3 +293,23 @@ def test_pictures_are_redrawn_from_a_clean_background(charged):
     assert first.shape[0] % 2 == 0 and first.shape[1] % 2 == 0
     assert not np.array_equal(first, last)
     np.testing.assert_array_equal(movie.frame(0), first)  # nothing left over from the last
+
+
+def test_snapshot_draws_the_frame_asked_for(charged):
+    """The snapshot of frame k draws the particles where they were then, the energy up to then
+    and the speeds then (the movie's picture of that frame); a frame that does not exist is
+    refused by name."""
+    from matplotlib.collections import EllipseCollection
+
+    for k in (0, 3, -1):
+        figure = render.snapshot(charged, k, dpi=DPI)
+        scene, energy, _ = figure.axes[:3]
+        assert scene.get_title().startswith(f"t = {charged.time[k]:.3f} s")
+        (disks,) = [c for c in scene.collections if isinstance(c, EllipseCollection)]
+        np.testing.assert_array_equal(disks.get_offsets(), charged.position[k])
+        shown = k % charged.frames + 1
+        assert all(len(line.get_xdata()) == shown for line in energy.get_lines()[:3])
+        assert not any(artist.get_animated() for artist in disks.axes.get_children())
+    for frame in (charged.frames, -charged.frames - 1, 1.5):
+        with pytest.raises(InputError, match="frame"):
+            render.snapshot(charged, frame)  # type: ignore[arg-type]

@@ -12,7 +12,7 @@ import collidium as cd
 from collidium.errors import InputError
 from collidium.io.trajectory import GSDWriter, read_trajectory
 from collidium.loading import load_scenario
-from collidium.runner import Job, execute, resume
+from collidium.runner import Job, execute, record, resume
 from test_cli import collidium
 
 TRAJECTORY = '\n[[observers]]\nkind = "trajectory"\npath = "mine.gsd"\nevery = 10\n'
@@ -186,3 +186,12 @@ def test_job_paths_are_stored_relative_to_the_checkpoint(tmp_path):
     assert Job.from_meta(meta, tmp_path) == job
     with pytest.raises(InputError, match="checkpoint"):
         Job(end_step=5, out="x.gsd", checkpoint="x.gsd")
+
+
+def test_record_returns_the_runs_trajectory_with_some_200_frames():
+    trajectory = record(load_scenario("gas", n=30), time=4.0)
+    assert trajectory.frames == 201 and trajectory.n == 30  # every 2 steps, both ends
+    np.testing.assert_allclose(trajectory.time[[0, -1]], [0.0, 4.0])
+    sim = cd.load("gas", n=30).run(time=4.0)
+    np.testing.assert_allclose(trajectory.position[-1], sim.particles.position, atol=1e-5)
+    assert record(load_scenario("gas", n=30), time=1.0, every=25).frames == 5

@@ -9,7 +9,6 @@ from __future__ import annotations
 import importlib
 import json
 import sys
-import tempfile
 import tomllib
 import warnings
 from collections.abc import Sequence
@@ -216,15 +215,9 @@ def _trajectory_of(
     if source.endswith(".gsd"):
         return read_trajectory(source)
     from collidium.loading import load_scenario
-    from collidium.runner import execute, prepare
+    from collidium.runner import record
 
-    with tempfile.TemporaryDirectory() as folder:
-        recording = Path(folder) / "run.gsd"
-        sim, job = prepare(load_scenario(source, **overrides), time, out=recording, every=every)
-        if every is None:  # some 200 frames
-            job.every = max(1, job.end_step // 200)
-        execute(sim, job, progress=sys.stderr.isatty())
-        return read_trajectory(recording)
+    return record(load_scenario(source, **overrides), time, every, progress=sys.stderr.isatty())
 
 
 def _report(summary: dict[str, Any], job: Job, as_json: bool) -> int:

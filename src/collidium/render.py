@@ -499,6 +499,41 @@ def write_movie(
     return path
 
 
+def snapshot(
+    trajectory: Trajectory,
+    frame: int = -1,
+    dpi: float = 100,
+    *,
+    bins: int = 30,
+    range: tuple[float, float] = (0.0, 30.0),
+) -> Figure:
+    """The movie's picture of one frame as a figure: the vessel with its particles then, the
+    energy up to then and the speeds then (`write_movie`), for a notebook or a report.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        K >= 1 frames.
+    frame : int
+        The frame, counted from the end when negative.
+    dpi, bins, range
+        As for `write_movie`.
+    """
+    _require_frames(trajectory)
+    if (
+        isinstance(frame, bool)
+        or not isinstance(frame, int)
+        or not -trajectory.frames <= frame < (trajectory.frames)
+    ):
+        raise InputError("frame", f"must be a frame of the {trajectory.frames}, got {frame!r}")
+    SpeedHistogram(bins=bins, range=range)
+    movie = _MovieFigure(trajectory, dpi, bins, range)
+    movie._update(frame % trajectory.frames)
+    for artist in movie.moving:  # drawn with the rest, not blitted
+        artist.set_animated(False)
+    return movie.figure
+
+
 def _mp4_available() -> bool:
     """True when imageio-ffmpeg and its ffmpeg binary can be used."""
     try:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import os
+import tempfile
 import time as clock
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
@@ -20,7 +21,13 @@ from pathlib import Path
 from typing import Any
 
 from collidium.errors import InputError
-from collidium.io.trajectory import GSDWriter, keep_frames_through, read_trajectory, write_xyz
+from collidium.io.trajectory import (
+    GSDWriter,
+    Trajectory,
+    keep_frames_through,
+    read_trajectory,
+    write_xyz,
+)
 from collidium.observers import (
     CollisionRate,
     EnergyDrift,
@@ -257,6 +264,21 @@ def prepare(
         max_drift=max_drift,
     )  # fmt: skip
     return spec.build(), job
+
+
+def record(
+    spec: Scenario, time: float | None = None, every: int | None = None, progress: bool = False
+) -> Trajectory:
+    """Run a scenario for ``time`` s (its own ``run.time`` by default) and return its trajectory,
+    a frame every ``every`` steps (some 200 frames by default), recorded through a temporary
+    GSD file: what `collidium render` draws, and the notebooks' figures."""
+    with tempfile.TemporaryDirectory() as folder:
+        recording = Path(folder) / "run.gsd"
+        sim, job = prepare(spec, time, out=recording, every=every)
+        if every is None:
+            job.every = max(1, job.end_step // 200)
+        execute(sim, job, progress=progress)
+        return read_trajectory(recording)
 
 
 def execute(sim: Simulation, job: Job, progress: bool = False) -> dict[str, Any]:

@@ -43,6 +43,8 @@ class Box(Vessel):
     partitions : sequence of Partition, optional
         Straight walls inside (a reflecting box only).
 
+    Notes
+    -----
     One wall of a reflecting box may be a `collidium.vessels.walls.Piston`
     (``walls={"top": Piston(position=5.0, mass=10.0, force=20.0)}``): it moves along its axis
     between the box's edge behind it and the opposite wall.
