@@ -515,3 +515,22 @@ def test_energy_drift_warns_and_max_drift_fails_the_run():
     clean = collidium("run", "charged-gas", "--time", "1", "--json", "--max-drift", "1e-5")
     assert clean.returncode == 0, clean.stderr
     assert json.loads(clean.stdout)["energy"]["warning"] is None
+
+
+def test_version_and_help_without_flag_types_or_empty_brackets():
+    import collidium as cd
+
+    assert collidium("--version").stdout == f"collidium {cd.__version__}\n"
+    commands = ["", "presets", "run", "resume", "inspect", "convert", "render", "export",
+                "sweep", "view"]  # fmt: skip
+    for command in commands:
+        result = collidium(*([command] if command else []), "--help")
+        assert result.returncode == 0, result.stderr
+        assert "<bool>" not in result.stdout and "()" not in result.stdout, result.stdout
+
+
+def test_a_few_bodies_get_no_temperature_or_maxwell_boltzmann_test():
+    table = collidium("run", "orbit", "--time", "1").stdout
+    assert table.count("n/a (2 particles, not a gas)") == 2
+    summary = json.loads(collidium("run", "orbit", "--time", "1", "--json").stdout)
+    assert summary["ks_pvalue"] is None and summary["temperature"] > 0  # kT = KE/N is defined

@@ -107,15 +107,38 @@ def test_energy_figure_plots_the_logged_series(charged):
     assert ax.get_ylabel() == "energy (J)"
 
 
-def test_speed_figure_pools_the_later_half_and_gives_the_ks_p_value(gas):
+def test_speed_figure_pools_the_later_half_and_gives_each_frames_ks_p_value(gas):
+    """The histogram pools the later frames; the title gives the KS p-values frame by frame
+    (the last frame's, the median and spread), never the pooled speeds' (they are correlated)."""
     expected = SpeedHistogram()
+    per_frame = []
     for k in range(gas.frames // 2, gas.frames):
-        expected.add(np.hypot(*gas.velocity[k].T), gas.mass, float(gas.log["temperature"][k, 0]))
+        speeds, kT = np.hypot(*gas.velocity[k].T), float(gas.log["temperature"][k, 0])
+        expected.add(speeds, gas.mass, kT)
+        per_frame.append(SpeedHistogram().add(speeds, gas.mass, kT).ks()[1])
     ax = render.speed_figure(gas).axes[0]
     heights = [bar.get_height() for bar in ax.patches]
     np.testing.assert_allclose(heights, expected.density)
-    assert f"p = {expected.ks()[1]:.3g}" in ax.get_title()
-    assert f"{gas.frames - gas.frames // 2} frames" in ax.get_title()
+    title = ax.get_title()
+    assert f"last frame: {per_frame[-1]:.3g}" in title
+    assert f"median {np.median(per_frame):.2g}" in title
+    assert f"p = {expected.ks()[1]:.3g}" not in title
+    assert f"{gas.frames - gas.frames // 2} frames" in title
+
+
+def test_speed_figures_last_frame_p_value_is_the_runs(tmp_path):
+    """`collidium render` and `collidium run --json` of the same run give the same p-value (to
+    the single precision the trajectory stores velocities in)."""
+    import json
+    import subprocess
+
+    def cli(*args):
+        command = [sys.executable, "-m", "collidium", *args]
+        return subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, check=True)
+
+    summary = json.loads(cli("run", "gas", "--time", "5", "--json", "--out", "g.gsd").stdout)
+    title = render.speed_figure(read_trajectory(tmp_path / "g.gsd")).axes[0].get_title()
+    assert f"last frame: {summary['ks_pvalue']:.3g}" in title
 
 
 def test_speed_figure_from_a_start_time(gas):
@@ -134,7 +157,8 @@ def test_temperature_and_kinetic_energy_come_from_the_velocities_without_a_log(g
     # Velocities are stored in single precision, so the sums agree to about 1e-7.
     np.testing.assert_allclose(kinetic.get_ydata(), gas.log["energy/kinetic"][:, 0], rtol=1e-5)
     title = render.speed_figure(bare).axes[0].get_title()
-    assert title.split("p = ")[1] == render.speed_figure(gas).axes[0].get_title().split("p = ")[1]
+    assert "last frame: " in title
+    assert title.split("p, ")[1] == render.speed_figure(gas).axes[0].get_title().split("p, ")[1]
 
 
 # -- movies ---------------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import zipfile
 
@@ -95,8 +96,12 @@ def test_resuming_a_finished_xyz_run_leaves_its_file_alone(tmp_path):
     assert before.count(b"Lattice=") == 11
     again = collidium("resume", "t.ckpt", "--json", cwd=tmp_path)
     assert again.returncode == 0, again.stderr
+    assert json.loads(again.stdout) == {"checkpoint": "t.ckpt", "finished": True, "steps": 100,
+                                        "time": 1.0}  # fmt: skip
     assert (tmp_path / "t.xyz").read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.ckpt", "t.xyz"]
+    said = collidium("resume", "t.ckpt", cwd=tmp_path)  # one line: nothing left to do
+    assert said.stdout == "t.ckpt: the run finished at step 100 (t = 1 s); nothing left to do\n"
 
 
 @pytest.mark.parametrize(

@@ -27,9 +27,30 @@ app = typer.Typer(
     name="collidium",
     help="Particles in a 2D vessel: exact elastic collisions, Coulomb forces, leapfrog.",
     no_args_is_help=True,
-    add_completion=False,
+    add_completion=True,  # --install-completion for bash, zsh, fish and PowerShell
     pretty_exceptions_enable=False,
 )
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        from collidium import __version__
+
+        typer.echo(f"collidium {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version", callback=_print_version, is_eager=True, help="Print the version and exit."
+        ),
+    ] = False,
+) -> None:
+    """Particles in a 2D vessel: exact elastic collisions, Coulomb forces, leapfrog."""  # fmt: skip
+
 
 MaxDriftOption = Annotated[
     float | None,
@@ -128,6 +149,13 @@ def resume_command(
     sim, job = resume(checkpoint)
     if max_drift is not None:
         job.max_drift = Job(end_step=job.end_step, max_drift=max_drift).max_drift  # checked
+    if sim.steps >= job.end_step:  # a finished run: its files are complete
+        done = {"checkpoint": str(checkpoint), "finished": True, "steps": sim.steps,
+                "time": sim.time}  # fmt: skip
+        line = (f"{checkpoint}: the run finished at step {sim.steps} (t = {sim.time:g} s); "
+                "nothing left to do")  # fmt: skip
+        typer.echo(json.dumps(done) if as_json else line)
+        return 0
     return _report(execute(sim, job, progress=not as_json and sys.stderr.isatty()), job, as_json)
 
 
@@ -174,7 +202,8 @@ def render_command(
         Path | None, typer.Option("--plots", help="Folder for energy.png and speeds.png.")
     ] = None,
     movie: Annotated[
-        Path | None, typer.Option("--movie", help="Movie file: .mp4 (needs [movie]) or .gif.")
+        Path | None,
+        typer.Option("--movie", help="Movie file: .mp4 (needs the movie extra) or .gif."),
     ] = None,
     time: Annotated[
         float | None, typer.Option("--time", help="Duration in s when running a scenario.")
@@ -494,14 +523,14 @@ def _print_summary(summary: dict[str, Any]) -> None:
         ("all collisions", f"{summary['collisions']['pair'] + summary['collisions']['wall']}"),
         *_heat_rows(summary["wall_heat"]),
         ("collision rate", _number(summary["collisions"]["rate"], "/s")),
-        ("temperature kT", _number(summary["temperature"], "J")),
+        ("temperature kT", _for_a_gas(summary, _number(summary["temperature"], "J"))),
         ("wall pressure", _number(pressure["wall"], "N/m", pressure["wall_error"])),
         ("virial pressure", _number(pressure["virial"], "N/m", pressure["virial_error"])),
         (
             "compressibility Z = PA/NkT",
             _number(summary["compressibility"], "", summary["compressibility_error"]),
         ),
-        ("Maxwell-Boltzmann KS p-value", _number(summary["ks_pvalue"], "")),
+        ("Maxwell-Boltzmann KS p-value", _for_a_gas(summary, _number(summary["ks_pvalue"], ""))),
         ("escaped", f"{summary['escaped']}"),
         *_piston_rows(summary.get("piston")),
         *_effusion_rows(summary.get("observers", [])),
@@ -556,6 +585,14 @@ def _effusion_rows(observers: list[dict[str, Any]]) -> list[tuple[str, str]]:
             (f"share across {where}", ", ".join(_number(x, "") for x in entry["escaped"])),
         ]  # fmt: skip
     return rows
+
+
+def _for_a_gas(summary: dict[str, Any], text: str) -> str:
+    """``text``, or why a few bodies have no such statistic."""
+    from collidium.runner import STATISTICS_FROM
+
+    n = summary["n"]
+    return text if n >= STATISTICS_FROM else f"n/a ({n} particles, not a gas)"
 
 
 def _number(value: float | None, unit: str, error: float | None = None) -> str:
@@ -614,10 +651,29 @@ def _fail(line: str, code: int) -> int:
     return code
 
 
+def _flags_without_type(command: Any) -> None:
+    """Flags take no value, so their help shows none (typer labels them ``<bool>``)."""
+    for param in command.params:
+        if getattr(param, "is_flag", False):
+            param.metavar = ""
+    make_help_option = command.get_help_option
+
+    def help_option(ctx: Any) -> Any:
+        option = make_help_option(ctx)
+        if option is not None:
+            option.metavar = ""
+        return option
+
+    command.get_help_option = help_option
+    for subcommand in getattr(command, "commands", {}).values():
+        _flags_without_type(subcommand)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Console entry point. Returns the exit status (0 ok, 1 failed run, 2 bad input)."""
     click_exception, usage_error = _click_exceptions()
     command = typer.main.get_command(app)
+    _flags_without_type(command)
     try:
         result = command.main(
             args=list(sys.argv[1:] if argv is None else argv),

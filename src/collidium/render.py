@@ -202,23 +202,38 @@ def speed_figure(
     -------
     Figure
         Probability density (s/m) against speed (m/s) with the Maxwell-Boltzmann curve at the
-        mean kT; the title gives the Kolmogorov-Smirnov p-value (indicative only: snapshots close
-        in time are correlated).
+        mean kT; the title gives the Kolmogorov-Smirnov p-values of the frames one by one (the
+        last frame's, and their median and spread), never that of the pooled speeds, which are
+        correlated.
     """
     _require_frames(trajectory)
     frames = _later_frames(trajectory, start)
     speed, kT = _speed_array(trajectory)[frames], _temperatures(trajectory)[frames]
     histogram = _histogram(speed, kT, trajectory.mass, bins, range)
     figure = _figure(7.0, 4.5)
-    histogram.plot(figure.add_subplot()).set_title(_speed_title(trajectory, frames, histogram))
+    histogram.plot(figure.add_subplot()).set_title(
+        _speed_title(trajectory, frames, histogram), fontsize="medium"
+    )
     return figure
 
 
 def _speed_title(trajectory: Trajectory, frames: np.ndarray, histogram: SpeedHistogram) -> str:
+    """What the histogram pools, and the Kolmogorov-Smirnov p-values of the frames one by one:
+    the last frame's (what ``collidium run --json`` reports for the same run) and the spread
+    over the frames. Frames close in time hold nearly the same speeds, so the pooled speeds are
+    not independent draws and their own p-value would mean nothing."""
     t0, t1 = float(trajectory.time[frames[0]]), float(trajectory.time[frames[-1]])
     title = f"{histogram.speeds.size} speeds, {len(frames)} frames, t = {t0:.4g} to {t1:.4g} s"
-    if histogram.speeds.size and histogram.temperature > 0:
-        title += f"\nKolmogorov-Smirnov p = {histogram.ks()[1]:.3g}"
+    speed, kT = _speed_array(trajectory), _temperatures(trajectory)
+    p = [
+        _histogram(speed[k : k + 1], kT[k : k + 1], trajectory.mass, 1, (0.0, 1.0)).ks()[1]
+        for k in frames
+        if kT[k] > 0 and trajectory.n > 0
+    ]
+    if p:
+        low, middle, high = np.percentile(p, [10, 50, 90])
+        title += (f"\nKolmogorov-Smirnov p, last frame: {p[-1]:.3g}; per frame: median "
+                  f"{middle:.2g}, 10-90% {low:.2g}-{high:.2g}")  # fmt: skip
     return title
 
 

@@ -118,11 +118,15 @@ def plot_energy(
     total_speed: FloatArray,
 ) -> Axes:
     """The seed's energy plot: kinetic (blue), potential (pink) and total (black) energy in J
-    against time in s, and the total speed (green, m/s) on a second axis. Returns ``ax``."""
+    against time in s, and the total speed (green, m/s) on a second axis. Returns ``ax``.
+
+    The total is drawn first and wide, the others dashed over it, so that a kinetic energy equal
+    to the total (a neutral gas) stays visible."""
     ax = new_axes(ax)
-    curves = {"kinetic": kinetic, "potential": potential, "total": kinetic + potential}
-    for name, values in curves.items():
-        ax.plot(time, values, color=SEED_COLOURS[name], label=name)
+    ax.plot(time, kinetic + potential, color=SEED_COLOURS["total"], label="total", linewidth=3.0,
+            alpha=0.6, zorder=1)  # fmt: skip
+    for name, values in (("kinetic", kinetic), ("potential", potential)):
+        ax.plot(time, values, color=SEED_COLOURS[name], label=name, linestyle="--", zorder=2)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("energy (J)")
     speed_axis = ax.twinx()
