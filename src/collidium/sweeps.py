@@ -23,6 +23,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import logging
 import math
 import os
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -320,9 +321,11 @@ def _cluster(client: Any, scheduler: str | None, workers: int | None) -> Iterato
         raise InputError("--workers", f"must be at least 1, got {count}")
     # One numba thread a worker: the cores are shared between workers, not within a run. The
     # dashboard takes a free port (8787 may be another cluster's).
+    # Workers log to stderr; a run's failure comes back as its row, and what they would say
+    # as the cluster shuts down (a heartbeat to a closed scheduler) is noise.
     cluster = LocalCluster(
         n_workers=count, threads_per_worker=1, processes=True, dashboard_address=":0",
-        env={"NUMBA_NUM_THREADS": "1"},
+        env={"NUMBA_NUM_THREADS": "1"}, silence_logs=logging.CRITICAL,
     )  # fmt: skip
     with cluster, Client(cluster) as local:
         yield local
