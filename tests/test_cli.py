@@ -534,3 +534,23 @@ def test_a_few_bodies_get_no_temperature_or_maxwell_boltzmann_test():
     assert table.count("n/a (2 particles, not a gas)") == 2
     summary = json.loads(collidium("run", "orbit", "--time", "1", "--json").stdout)
     assert summary["ks_pvalue"] is None and summary["temperature"] > 0  # kT = KE/N is defined
+
+
+def test_ctrl_c_says_where_the_run_stopped_and_what_it_kept(tmp_path):
+    command = [sys.executable, "-m", "collidium", "run", "gas", "--set", "n=600", "--time",
+               "100000", "--out", "r.gsd", "--checkpoint", "r.ckpt", "--checkpoint-every",
+               "2000"]  # fmt: skip
+    process = subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.PIPE, text=True)  # fmt: skip
+    deadline = time.monotonic() + 120
+    while not (tmp_path / "r.ckpt").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == 130
+    assert stderr.count("\n") == 1 and stderr.startswith("error: interrupted at step "), stderr
+    from collidium.io.trajectory import read_trajectory
+
+    last = int(read_trajectory(tmp_path / "r.gsd").step[-1])
+    assert f"{tmp_path / 'r.gsd'} (frames to step {last})" in stderr
+    assert f"{tmp_path / 'r.ckpt'} (step " in stderr and "collidium resume" in stderr

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 from pydantic import ValidationError
 
-from collidium.errors import InputError, SimulationError
+from collidium.errors import InputError, Interrupted, SimulationError
 
 if TYPE_CHECKING:
     from collidium.runner import Job
@@ -696,8 +696,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except click_exception as exc:
         message = exc.format_message() if hasattr(exc, "format_message") else str(exc)
         return _fail(f"input: {message}", 2)
+    except Interrupted as exc:  # a run: where it stopped, what it kept
+        return _fail(str(exc), 130)
     except (typer.Abort, KeyboardInterrupt):
         return _fail("interrupted", 130)
     except OSError as exc:  # e.g. the output stream is full or closed
         return _fail(f"output: {exc.strerror or exc}", 1)
+    if result == 130:  # Ctrl-C outside a run, which typer answers with a silent exit 130
+        return _fail("interrupted", 130)
     return result if isinstance(result, int) else 0

@@ -30,3 +30,8 @@ class InputError(ValueError):
 
 class SimulationError(RuntimeError):
     """A run stopped because its state became invalid (never a silent blow-up)."""
+
+
+class Interrupted(Exception):
+    """Ctrl-C during a run: the message says where it stopped and what was kept. (Not a
+    KeyboardInterrupt: the command line's framework would turn that into a silent exit.)"""

@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from collidium.errors import InputError
+from collidium.errors import InputError, Interrupted
 from collidium.io.trajectory import (
     GSDWriter,
     Trajectory,
@@ -194,6 +194,8 @@ class CheckpointWriter:
         self.trigger: Trigger = Every(period)
         self.job = job
         self.drift = drift
+        #: The step of the last checkpoint this writer saved (None before the first).
+        self.saved_step: int | None = None
 
     def attach(self, sim: Simulation) -> None:
         """Nothing to do before the run."""
@@ -204,6 +206,7 @@ class CheckpointWriter:
             if isinstance(observer, GSDWriter):
                 observer.flush()
         save(sim, self.job, self.drift)
+        self.saved_step = sim.steps
 
 
 def save(sim: Simulation, job: Job, drift: EnergyDrift) -> None:
@@ -310,6 +313,8 @@ def execute(sim: Simulation, job: Job, progress: bool = False) -> dict[str, Any]
     with _staging_named_as_out(job):
         try:
             sim.run(steps=remaining, progress=progress)
+        except KeyboardInterrupt:
+            raise Interrupted(_where_stopped(sim, job)) from None
         finally:  # this run's trajectory and any a scenario file asked for
             for observer in sim.observers:
                 if isinstance(observer, GSDWriter):
@@ -323,6 +328,20 @@ def execute(sim: Simulation, job: Job, progress: bool = False) -> dict[str, Any]
         write_xyz(read_trajectory(trajectory), str(job.out))
         trajectory.unlink()
     return summarise(sim, job, thermo, rate, wall, reported)
+
+
+def _where_stopped(sim: Simulation, job: Job) -> str:
+    """One line for Ctrl-C: the step and time the run stopped at, and the files kept."""
+    kept = []
+    for observer in sim.observers:
+        if isinstance(observer, GSDWriter) and observer.frames_written:
+            name = job.out if job.staged and observer.path == job.trajectory else observer.path
+            kept.append(f"{name} (frames to step {observer.last_step})")
+        if isinstance(observer, CheckpointWriter) and observer.saved_step is not None:
+            kept.append(f"{observer.path} (step {observer.saved_step}; `collidium resume "
+                        f"{observer.path}` finishes the run)")  # fmt: skip
+    return (f"interrupted at step {sim.steps} of {job.end_step} (t = {sim.time:g} s); kept: "
+            + (", ".join(kept) if kept else "nothing"))  # fmt: skip
 
 
 @contextmanager

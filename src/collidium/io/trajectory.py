@@ -214,6 +214,11 @@ class GSDWriter:
         if self.flush_seconds == 0:
             self.flush()
 
+    @property
+    def last_step(self) -> int:
+        """The step of the last frame in the file (-1 before any)."""
+        return self._last_step
+
     def flush(self) -> None:
         """Write the buffered frames to disk now."""
         if self._file is not None:
