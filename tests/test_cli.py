@@ -554,3 +554,11 @@ def test_ctrl_c_says_where_the_run_stopped_and_what_it_kept(tmp_path):
     last = int(read_trajectory(tmp_path / "r.gsd").step[-1])
     assert f"{tmp_path / 'r.gsd'} (frames to step {last})" in stderr
     assert f"{tmp_path / 'r.ckpt'} (step " in stderr and "collidium resume" in stderr
+
+
+@pytest.mark.parametrize("name", ["effusion", "piston", "heat-flow"])
+def test_the_run_table_fits_80_columns(name):
+    """The presets with the most rows and the longest values (walls, species, the piston)."""
+    result = collidium("run", name, "--time", "1")
+    assert result.returncode == 0, result.stderr
+    assert max(len(line) for line in result.stdout.splitlines()) <= 80
