@@ -562,3 +562,25 @@ def test_the_run_table_fits_80_columns(name):
     result = collidium("run", name, "--time", "1")
     assert result.returncode == 0, result.stderr
     assert max(len(line) for line in result.stdout.splitlines()) <= 80
+
+
+def test_quiet_says_nothing_but_warnings_and_verbose_says_what_runs(tmp_path):
+    quiet = collidium("run", "gas", "--time", "1", "-q")
+    assert (quiet.returncode, quiet.stdout, quiet.stderr) == (0, "", "")
+    exploding = ["run", "charged-gas", "--time", "1", "--set", "k=5000", "--set",
+                 "run.integrator=fixed", "-q"]  # fmt: skip
+    warned = collidium(*exploding)
+    assert warned.returncode == 0 and warned.stdout == ""
+    assert warned.stderr.startswith("warning: the total energy drifted by")
+    assert warned.stderr.count("\n") == 1
+    failed = collidium(*exploding, "--max-drift", "0.1")
+    assert failed.returncode == 1 and failed.stdout == "" and failed.stderr.count("\n") == 1
+    verbose = collidium("run", "gas", "--time", "1", "-v", "--out", "v.gsd", cwd=tmp_path)
+    assert verbose.returncode == 0
+    assert verbose.stderr.startswith(
+        "running gas: 200 particles, 100 steps of 0.01 s from t = 0 s, exact collisions, "
+        f"adaptive integrator; writing {tmp_path / 'v.gsd'}\n"
+    )
+    assert "collidium run: gas" in verbose.stdout  # the summary as usual
+    both = collidium("run", "gas", "-q", "-v")
+    assert both.returncode == 2 and both.stderr.startswith("error: --quiet:")

@@ -52,6 +52,18 @@ def _options(
     """Particles in a 2D vessel: exact elastic collisions, Coulomb forces, leapfrog."""  # fmt: skip
 
 
+QuietOption = Annotated[
+    bool,
+    typer.Option(
+        "--quiet", "-q", help="Print nothing on success; a drift warning is one line on stderr."
+    ),
+]
+VerboseOption = Annotated[
+    bool,
+    typer.Option("--verbose", "-v",
+                 help="Say what runs before it starts, and show its progress bar."),
+]  # fmt: skip
+
 MaxDriftOption = Annotated[
     float | None,
     typer.Option(
@@ -121,10 +133,12 @@ def run_command(
     ] = None,
     max_drift: MaxDriftOption = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    quiet: QuietOption = False,
+    verbose: VerboseOption = False,
 ) -> int:
     """Run a preset or scenario file and print a summary."""
     from collidium.loading import load_scenario
-    from collidium.runner import execute, prepare
+    from collidium.runner import prepare
 
     if time is not None and steps is not None:
         raise InputError("--time", "give --time or --steps, not both")
@@ -134,7 +148,7 @@ def run_command(
         load_scenario(scenario, **values), time, steps, out, every, checkpoint, checkpoint_every,
         max_drift,
     )  # fmt: skip
-    return _report(execute(sim, job, progress=not as_json and sys.stderr.isatty()), job, as_json)
+    return _run(sim, job, as_json, quiet, verbose)
 
 
 @app.command("resume")
@@ -142,9 +156,11 @@ def resume_command(
     checkpoint: Annotated[Path, typer.Argument(help="Checkpoint written by run --checkpoint.")],
     max_drift: MaxDriftOption = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    quiet: QuietOption = False,
+    verbose: VerboseOption = False,
 ) -> int:
     """Finish an interrupted run from its checkpoint (bitwise the same as never stopping)."""
-    from collidium.runner import Job, execute, resume
+    from collidium.runner import Job, resume
 
     sim, job = resume(checkpoint)
     if max_drift is not None:
@@ -154,9 +170,10 @@ def resume_command(
                 "time": sim.time}  # fmt: skip
         line = (f"{checkpoint}: the run finished at step {sim.steps} (t = {sim.time:g} s); "
                 "nothing left to do")  # fmt: skip
-        typer.echo(json.dumps(done) if as_json else line)
+        if not quiet:
+            typer.echo(json.dumps(done) if as_json else line)
         return 0
-    return _report(execute(sim, job, progress=not as_json and sys.stderr.isatty()), job, as_json)
+    return _run(sim, job, as_json, quiet, verbose)
 
 
 @app.command("inspect")
@@ -249,16 +266,46 @@ def _trajectory_of(
     return record(load_scenario(source, **overrides), time, every, progress=sys.stderr.isatty())
 
 
-def _report(summary: dict[str, Any], job: Job, as_json: bool) -> int:
-    """Print the summary; exit status 1 if the energy drifted past ``--max-drift``."""
+def _run(sim: Any, job: Job, as_json: bool, quiet: bool, verbose: bool) -> int:
+    """Run the job as asked to say it: the summary, nothing (quiet) or a first line and the
+    progress bar (verbose)."""
+    from collidium.runner import execute
+
+    if quiet and verbose:
+        raise InputError("--quiet", "give --quiet or --verbose, not both")
+    if verbose:
+        sys.stderr.write(f"{_plan_line(sim, job)}\n")
+    progress = verbose or (not as_json and not quiet and sys.stderr.isatty())
+    return _report(execute(sim, job, progress=progress), job, as_json, quiet)
+
+
+def _plan_line(sim: Any, job: Job) -> str:
+    """What is about to run, in one line."""
+    steps = job.end_step - sim.steps
+    outputs = [f for f in (job.out, job.checkpoint) if f is not None]
+    return (f"running {sim.name}: {sim.particles.n} particles, {steps} steps of {sim.dt:g} s "
+            f"from t = {sim.time:g} s, {sim.collisions} collisions, {sim.integrator} "
+            f"integrator" + (f"; writing {', '.join(outputs)}" if outputs else ""))  # fmt: skip
+
+
+def _report(summary: dict[str, Any], job: Job, as_json: bool, quiet: bool = False) -> int:
+    """Print the summary (quiet: only a drift warning, on stderr); exit status 1 if the energy
+    drifted past ``--max-drift``."""
     from collidium.runner import drift_exceeded
 
-    if as_json:
+    if job.max_drift is not None and drift_exceeded(job):
+        if as_json and not quiet:
+            typer.echo(json.dumps(summary))
+        elif not quiet:
+            _print_summary(summary)
+        return _fail(f"--max-drift: {summary['energy']['warning']}", 1)
+    if quiet:
+        if summary["energy"]["warning"]:
+            _warn(summary["energy"]["warning"])
+    elif as_json:
         typer.echo(json.dumps(summary))
     else:
         _print_summary(summary)
-    if job.max_drift is not None and drift_exceeded(job):
-        return _fail(f"--max-drift: {summary['energy']['warning']}", 1)
     return 0
 
 
