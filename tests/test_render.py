@@ -103,8 +103,11 @@ def test_energy_figure_plots_the_logged_series(charged):
     np.testing.assert_allclose(
         curves["total speed"].get_ydata(), charged.log["energy/total_speed"][:, 0]
     )
-    assert ax.get_xlabel() == "time (s)"
     assert ax.get_ylabel() == "energy (J)"
+    speed_panel = figure.axes[1]  # the total speed on a small panel of its own, below
+    assert [line.get_label() for line in speed_panel.get_lines()] == ["total speed"]
+    assert speed_panel.get_xlabel() == "time (s)"
+    assert speed_panel.bbox.height < ax.bbox.height / 2
 
 
 def test_speed_figure_pools_the_later_half_and_gives_each_frames_ks_p_value(gas):

@@ -136,28 +136,27 @@ def energy_figure(trajectory: Trajectory) -> Figure:
         Kinetic, potential and total energy (J) and the total speed (m/s) against time (s).
     """
     _require_frames(trajectory)
-    figure = _figure(7.0, 4.8)
-    _energy_plot(figure.add_subplot(), trajectory)
+    figure = _figure(7.0, 5.2)
+    energy, speed = figure.subplots(2, 1, sharex=True, height_ratios=(3, 1))
+    _energy_plot(energy, trajectory, speed)
     figure.suptitle(f"energy of {trajectory.n} particles")
     return figure
 
 
-def _energy_plot(ax: Axes, trajectory: Trajectory) -> list[Line2D]:
-    """`plot_energy` on ``ax`` with its legend moved above the axes, clear of the curves and of
-    the twin axes (which would draw over it); returns the curves, those of the twin included."""
-    figure = ax.get_figure()
-    before = set(figure.axes) if figure is not None else set()
-    plot_energy(ax, trajectory.time, *_energy_series(trajectory))
-    twins = [a for a in figure.axes if a not in before] if figure is not None else []
-    lines = [line for a in (ax, *twins) for line in a.get_lines()]
+def _energy_plot(ax: Axes, trajectory: Trajectory, speed_ax: Axes) -> list[Line2D]:
+    """`plot_energy` on ``ax``, the total speed on its own small panel ``speed_ax``, with the
+    legend moved above the axes, clear of the curves; returns the curves of both."""
+    plot_energy(ax, trajectory.time, *_energy_series(trajectory), speed_ax=speed_ax)
+    lines = ax.get_lines() + speed_ax.get_lines()
+    ax.tick_params(labelbottom=False)
     legend = ax.get_legend()
     if legend is not None:
         legend.remove()
     ax.legend(
-        lines,
-        [str(line.get_label()) for line in lines],
+        ax.get_lines(),
+        [str(line.get_label()) for line in ax.get_lines()],
         loc="lower left",
-        ncols=4,
+        ncols=3,
         bbox_to_anchor=(0.0, 1.01, 1.0, 0.1),
         mode="expand",
         frameon=False,
@@ -297,7 +296,9 @@ class _MovieFigure:
         self.canvas = FigureCanvasAgg(self.figure)
         grid = self.figure.add_gridspec(2, 2, width_ratios=(vessel_width, 5.5))
         self._vessel(self.figure.add_subplot(grid[:, 0]))
-        self._energy(self.figure.add_subplot(grid[0, 1]))
+        rows = grid[0, 1].subgridspec(2, 1, height_ratios=(3, 1), hspace=0.05)
+        energy = self.figure.add_subplot(rows[0])
+        self._energy(energy, self.figure.add_subplot(rows[1], sharex=energy))
         self._speeds(self.figure.add_subplot(grid[1, 1]), bins, span)
         self.moving: list[Artist] = [
             self.disk_artist,
@@ -365,10 +366,10 @@ class _MovieFigure:
         self.clock: Text = ax.set_title(" ")
         self.boundary = "periodic" if t.periodic else "reflecting walls"
 
-    def _energy(self, ax: Axes) -> None:
+    def _energy(self, ax: Axes, speed_ax: Axes) -> None:
         self.curves: list[tuple[Line2D, FloatArray, FloatArray]] = [
             (line, np.asarray(line.get_xdata()), np.asarray(line.get_ydata()))
-            for line in _energy_plot(ax, self.trajectory)
+            for line in _energy_plot(ax, self.trajectory, speed_ax)
         ]
 
     def _speeds(self, ax: Axes, bins: int, span: tuple[float, float]) -> None:

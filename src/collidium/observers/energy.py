@@ -116,9 +116,11 @@ def plot_energy(
     kinetic: FloatArray,
     potential: FloatArray,
     total_speed: FloatArray,
+    speed_ax: Axes | None = None,
 ) -> Axes:
     """The seed's energy plot: kinetic (blue), potential (pink) and total (black) energy in J
-    against time in s, and the total speed (green, m/s) on a second axis. Returns ``ax``.
+    against time in s, and the total speed (green, m/s) on ``speed_ax`` (a small panel of its
+    own), or on a second axis of ``ax`` without one. Returns ``ax``.
 
     The total is drawn first and wide, the others dashed over it, so that a kinetic energy equal
     to the total (a neutral gas) stays visible."""
@@ -127,12 +129,19 @@ def plot_energy(
             alpha=0.6, zorder=1)  # fmt: skip
     for name, values in (("kinetic", kinetic), ("potential", potential)):
         ax.plot(time, values, color=SEED_COLOURS[name], label=name, linestyle="--", zorder=2)
-    ax.set_xlabel("time (s)")
     ax.set_ylabel("energy (J)")
-    speed_axis = ax.twinx()
-    speed_axis.plot(time, total_speed, color=SEED_COLOURS["total_speed"], label="total speed")
-    speed_axis.set_ylabel("total speed (m/s)", color=SEED_COLOURS["total_speed"])
-    lines = ax.get_lines() + speed_axis.get_lines()
+    green = SEED_COLOURS["total_speed"]
+    if speed_ax is None:
+        ax.set_xlabel("time (s)")
+        speed_axis = ax.twinx()
+        speed_axis.plot(time, total_speed, color=green, label="total speed")
+        speed_axis.set_ylabel("total speed (m/s)", color=green)
+        lines = ax.get_lines() + speed_axis.get_lines()
+    else:
+        speed_ax.plot(time, total_speed, color=green, label="total speed")
+        speed_ax.set_xlabel("time (s)")
+        speed_ax.set_ylabel("total speed\n(m/s)", color=green, fontsize="small")
+        lines = ax.get_lines()
     ax.legend(lines, [str(line.get_label()) for line in lines], loc="lower right", fontsize="small")
     return ax
 
