@@ -85,15 +85,16 @@ def test_a_sweep_run_again_skips_the_runs_it_has(tmp_path, two_workers):
 def test_a_killed_sweep_keeps_its_finished_runs_and_resumes(tmp_path):
     """kill -9 of the whole sweep (its workers too) once runs have finished: they are in the
     runs' folder, and the sweep started again runs only the others."""
+    # Runs of some 0.2 s each: the sweep is caught with runs both done and to do.
     command = [sys.executable, "-m", "collidium", "sweep", "gas", "--grid", "n=20,30,40,50,60,70",
-               "--time", "20", "--out", "r.parquet", "--workers", "1"]  # fmt: skip
+               "--time", "100", "--out", "r.parquet", "--workers", "1"]  # fmt: skip
     process = subprocess.Popen(command, cwd=tmp_path, start_new_session=True,
                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)  # fmt: skip
     folder = tmp_path / "r.parquet.runs"
     try:
         deadline = time.monotonic() + 120
         while len(list(folder.glob("*.json"))) < 2 and time.monotonic() < deadline:
-            time.sleep(0.05)
+            time.sleep(0.01)
     finally:
         os.killpg(process.pid, signal.SIGKILL)
         process.wait()
