@@ -114,3 +114,9 @@ def test_plot_and_summary():
     summary = thermo.summary()
     assert summary["pressure"]["wall"] == thermo.wall_pressure()["total"]
     assert set(summary["pressure"]["walls"]) == {"left", "right", "bottom", "top"}
+
+
+def test_compressibility_is_nan_for_disks_at_rest():
+    """N kT = 0: no ideal-gas pressure to divide by (the fuzz test found the division)."""
+    thermo = measure(cd.load("gas", speed=0.0), 1.0)
+    assert np.isnan(thermo.compressibility()) and np.isnan(thermo.compressibility_error())

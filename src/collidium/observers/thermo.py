@@ -16,6 +16,7 @@ virial theorem with the walls' forces included), and an ideal gas has ``P A_c = 
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -167,12 +168,18 @@ class Thermo(Measurement):
         return _standard_error(_blocks(*self._virial_values())[0])
 
     def compressibility(self) -> float:
-        """``Z = P A_c / (N kT)`` from the virial pressure (1 for an ideal gas)."""
-        return self.virial_pressure() * self.area / (self.n * self.temperature)
+        """``Z = P A_c / (N kT)`` from the virial pressure (1 for an ideal gas); NaN without
+        particles or motion (N kT = 0)."""
+        return self._per_ideal_gas(self.virial_pressure())
 
     def compressibility_error(self) -> float:
         """Standard error of `compressibility`, from that of the virial pressure."""
-        return self.virial_pressure_error() * self.area / (self.n * self.temperature)
+        return self._per_ideal_gas(self.virial_pressure_error())
+
+    def _per_ideal_gas(self, pressure: float) -> float:
+        """``pressure`` over the ideal gas's ``N kT / A_c``; NaN where that is not > 0."""
+        ideal = self.n * self.temperature / self.area
+        return pressure / ideal if ideal > 0 else math.nan
 
     def plot(self, ax: Axes | None = None) -> Axes:
         """Block averages of the wall and virial pressures over time, with the ideal-gas value."""
