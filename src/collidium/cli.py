@@ -140,8 +140,6 @@ def run_command(
     from collidium.loading import load_scenario
     from collidium.runner import prepare
 
-    if time is not None and steps is not None:
-        raise InputError("--time", "give --time or --steps, not both")
     values = parse_settings(overrides or [])
     values |= {k: v for k, v in (("dt", dt), ("seed", seed)) if v is not None}
     sim, job = prepare(

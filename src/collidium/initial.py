@@ -251,6 +251,10 @@ def hexagonal_positions(vessel: Vessel, radius: float, packing: float) -> FloatA
     return centres[inside]
 
 
+#: The densest packing of equal disks, the hexagonal lattice's: pi / sqrt(12).
+CLOSE_PACKING = math.pi / math.sqrt(12.0)
+
+
 def lattice_spacing(radius: float, packing: float) -> float:
     """Distance between neighbouring centres (m) of a hexagonal lattice of disks of ``radius`` (m)
     covering the share ``packing`` of the plane: each disk has a cell of ``sqrt(3)/2 a^2``."""

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from collidium.errors import InputError
-from collidium.initial import lattice_spacing
+from collidium.initial import CLOSE_PACKING, lattice_spacing
 from collidium.integrators import DEFAULT_TOLERANCE
 
 if TYPE_CHECKING:
@@ -325,8 +325,8 @@ def hard_disks(
         raise InputError(
             "rows", f"must be even, so that the lattice fills the periodic box; got {rows}"
         )
-    if not 0.0 < packing <= 0.9069:
-        raise InputError("packing", f"must be in (0, 0.9069], got {packing!r}")
+    if not 0.0 < packing <= CLOSE_PACKING:
+        raise InputError("packing", f"must be in (0, {CLOSE_PACKING:.4f}], got {packing!r}")
     spacing = lattice_spacing(radius, packing)
     width, height = columns * spacing, rows * spacing * math.sqrt(3.0) / 2.0
     lattice = {"kind": "lattice", "columns": columns, "rows": rows, "packing": packing,

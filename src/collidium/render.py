@@ -225,7 +225,7 @@ def _speed_title(trajectory: Trajectory, frames: np.ndarray, histogram: SpeedHis
     title = f"{histogram.speeds.size} speeds, {len(frames)} frames, t = {t0:.4g} to {t1:.4g} s"
     speed, kT = _speed_array(trajectory), _temperatures(trajectory)
     p = [
-        _histogram(speed[k : k + 1], kT[k : k + 1], trajectory.mass, 1, (0.0, 1.0)).ks()[1]
+        SpeedHistogram().add(speed[k], trajectory.mass, float(kT[k])).ks()[1]
         for k in frames
         if kT[k] > 0 and trajectory.n > 0
     ]

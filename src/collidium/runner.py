@@ -245,6 +245,14 @@ def resume(path: str | Path) -> tuple[Simulation, Job]:
     return sim, job
 
 
+def steps_of(spec: Scenario, time: float | None = None, steps: int | None = None) -> int:
+    """The steps a run of the scenario takes: ``time`` s, or ``steps``, or its ``run.time``."""
+    if time is not None and steps is not None:
+        raise InputError("--time", "give --time or --steps, not both")
+    duration = spec.run.time if time is None and steps is None else time
+    return step_count(duration, steps, spec.run.dt)
+
+
 def prepare(
     spec: Scenario,
     time: float | None = None,
@@ -260,11 +268,8 @@ def prepare(
     The run lasts ``time`` s or ``steps`` steps (the scenario's ``run.time`` if neither); frames
     go to ``out`` every ``every`` steps (0.1 s by default).
     """
-    if time is not None and steps is not None:
-        raise InputError("--time", "give --time or --steps, not both")
-    duration = spec.run.time if time is None and steps is None else time
     job = Job(
-        end_step=step_count(duration, steps, spec.run.dt), out=None if out is None else str(out),
+        end_step=steps_of(spec, time, steps), out=None if out is None else str(out),
         every=every if every is not None else max(1, round(0.1 / spec.run.dt)),
         checkpoint=None if checkpoint is None else str(checkpoint),
         checkpoint_every=checkpoint_every, observers=spec.to_dict().get("observers", []),

@@ -88,6 +88,7 @@ from pydantic import (
 from collidium.errors import InputError
 from collidium.forces import DEFAULT_THETA, Coulomb
 from collidium.initial import (
+    CLOSE_PACKING,
     balanced_charges,
     hexagonal_block,
     random_positions,
@@ -654,7 +655,7 @@ class LatticeGroup(_Model):
     kind: Literal["lattice"] = "lattice"
     columns: Annotated[int, Field(ge=1, le=MAX_GROUP_SIZE)]
     rows: Annotated[int, Field(ge=1, le=MAX_GROUP_SIZE)]
-    packing: Annotated[float, Field(gt=0.0, le=0.9069)]
+    packing: Annotated[float, Field(gt=0.0, le=CLOSE_PACKING)]
     radius: Positive = 0.5
     mass: Positive = 1.0
     speed: NonNegative = 0.0

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any
 from collidium.errors import InputError, SimulationError
 from collidium.io.atomic import replacing
 from collidium.loading import load_scenario
-from collidium.runner import execute, prepare
+from collidium.runner import execute, prepare, steps_of
 from collidium.scenario import Scenario
 from collidium.theory import hard_disk_compressibility
 
@@ -115,19 +115,12 @@ def plan(
         parameters = dict(zip(values, point, strict=True))
         for seed in seed_list:
             spec = load_scenario(scenario, **parameters, seed=seed)
-            steps = _steps(spec, time)
+            steps = steps_of(spec, time)
             data = spec.to_dict()
             text = json.dumps([data, steps], sort_keys=True, default=str)
             key = hashlib.sha256(text.encode()).hexdigest()[:16]
             runs.append(Run(len(runs), parameters, seed, data, steps, key))
     return runs
-
-
-def _steps(spec: Scenario, time: float | None) -> int:
-    """Steps of a run of ``time`` s (the scenario's own ``run.time`` if None)."""
-    from collidium.simulation import step_count
-
-    return step_count(spec.run.time if time is None else time, None, spec.run.dt)
 
 
 def _seeds(seeds: int | Sequence[int]) -> list[int]:
