@@ -9,7 +9,7 @@ from typing import Literal
 
 import numpy as np
 
-from collidium.errors import InputError
+from collidium.errors import InputError, SimulationError
 from collidium.kernels import tree
 from collidium.kernels.pairwise import coulomb_direct, coulomb_stiffness
 from collidium.state import FloatArray, Particles
@@ -166,6 +166,18 @@ class Coulomb:
         return out
 
 
+def _refuse_infinite(acceleration: FloatArray) -> None:
+    """One line naming the first particle whose acceleration (N, 2) overflowed (a force on a
+    mass too small to move by it)."""
+    finite = np.isfinite(acceleration).all(axis=1)
+    if not finite.all():
+        i = int(np.argmin(finite))
+        raise SimulationError(
+            f"particle {i}: the force on it gives an infinite acceleration (its mass is too "
+            "small for the force)"
+        )
+
+
 class ForceField:
     """All forces of a simulation: total acceleration and potential energy, with reused buffers.
 
@@ -212,7 +224,9 @@ class ForceField:
         potential = virial = 0.0
         for force, work in zip(self.forces, self._work, strict=True):
             force.compute(particles, vessel, self._force, self._energy, self._virial, work)
-            np.divide(self._force, particles.mass[:, None], out=self._force)  # now an acceleration
+            with np.errstate(over="ignore"):  # an infinite acceleration is refused just below
+                np.divide(self._force, particles.mass[:, None], out=self._force)
+            _refuse_infinite(self._force)
             force.limit(self._force)
             self._acceleration += self._force
             potential += float(np.sum(self._energy))

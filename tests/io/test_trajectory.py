@@ -121,13 +121,55 @@ def test_xyz_export(tmp_path):
     assert lines[0] == "200"
     header = lines[1]
     assert 'Lattice="20 0 0 0 20 0 0 0 1"' in header and 'pbc="F F F"' in header
-    assert "Properties=species:S:1:pos:R:3:velo:R:3:mass:R:1:radius:R:1:charge:R:1" in header
-    last = np.array([line.split()[1:] for line in lines[-200:]], dtype=float)
+    properties = "species:S:1:Z:I:1:pos:R:3:velo:R:3:mass:R:1:radius:R:1:charge:R:1"
+    assert f"Properties={properties}" in header
+    last = np.array([line.split()[2:] for line in lines[-200:]], dtype=float)
     # Nine significant digits give back the stored single-precision values exactly.
     f32 = np.float32
     np.testing.assert_array_equal(last[:, :2].astype(f32), trajectory.position[-1].astype(f32))
     np.testing.assert_array_equal(last[:, 3:5].astype(f32), trajectory.velocity[-1].astype(f32))
     np.testing.assert_array_equal(last[:, 8], trajectory.charge)
+
+
+def test_ase_reads_the_xyz_export(tmp_path):
+    """ASE reads every frame: positions, charges, the walled box as not periodic, the time, and
+    the velocities by their column's name (it takes the types as chemical symbols unless a Z
+    column is there)."""
+    import ase.io as ase_io  # a test dependency, like freud and MDAnalysis
+
+    _, path = record(tmp_path)
+    trajectory = read_trajectory(path)
+    write_xyz(trajectory, tmp_path / "run.xyz")
+    frames = ase_io.read(tmp_path / "run.xyz", index=":")
+    assert len(frames) == trajectory.frames
+    last = frames[-1]
+    assert not last.pbc.any()
+    assert last.info["Time"] == pytest.approx(trajectory.time[-1])
+    np.testing.assert_allclose(last.positions[:, :2], trajectory.position[-1], rtol=1e-7)
+    np.testing.assert_allclose(last.arrays["velo"][:, :2], trajectory.velocity[-1], rtol=1e-7)
+    np.testing.assert_array_equal(last.get_charges(), trajectory.charge)  # as computed charges
+
+
+@pytest.mark.parametrize("boundary", ["reflecting", "periodic"])
+def test_mdanalysis_gets_time_step_and_velocities(tmp_path, boundary):
+    """`universe` gives MDAnalysis the real time between frames, the velocities and, for a
+    periodic box only, the box."""
+    _, path = record(tmp_path, "gas", every=10, steps=50, **{"vessel.boundary": boundary})
+    trajectory = read_trajectory(path)
+    universe = trajectory_module.universe(path)
+    assert universe.trajectory.n_frames == trajectory.frames == 6
+    assert universe.trajectory.dt == pytest.approx(10 * 0.01)
+    universe.trajectory[-1]
+    assert universe.trajectory.ts.time == pytest.approx(trajectory.time[-1])
+    np.testing.assert_allclose(universe.atoms.velocities[:, :2], trajectory.velocity[-1],
+                               rtol=1e-6)  # fmt: skip
+    np.testing.assert_allclose(universe.atoms.positions[:, :2], trajectory.position[-1],
+                               rtol=1e-6)  # fmt: skip
+    np.testing.assert_array_equal(universe.atoms.masses, trajectory.mass)
+    if boundary == "periodic":
+        np.testing.assert_allclose(universe.dimensions[:2], [trajectory.width, trajectory.height])
+    else:
+        assert universe.dimensions is None
 
 
 def test_killed_writer_leaves_every_flushed_frame(tmp_path):

@@ -35,8 +35,11 @@ def write_checkpoint(path: str | Path, arrays: dict[str, np.ndarray], meta: dict
     """
     header = {"format": FORMAT, "version": VERSION} | meta
     encoded = np.frombuffer(json.dumps(header).encode("utf-8"), dtype=np.uint8)
+    pickled = [name for name, array in arrays.items() if array.dtype.hasobject]
+    if pickled:  # np.savez would pickle them (its allow_pickle needs NumPy 2.2)
+        raise ValueError(f"checkpoint arrays of Python objects: {pickled}")
     with replacing(path) as temporary, temporary.open("wb") as stream:
-        np.savez(stream, allow_pickle=False, **({_META: encoded} | arrays))
+        np.savez(stream, **({_META: encoded} | arrays))
         stream.flush()
         os.fsync(stream.fileno())
 

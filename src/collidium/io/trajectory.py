@@ -6,6 +6,16 @@ z = 0, velocities, masses, charges and diameters, a particle type per sign of th
 observables under ``log/`` (`LOG_KEYS`), among them the vessel itself, so that readers redraw
 its real outline. Positions and velocities are stored in single precision, as the schema
 does by default; checkpoints (`collidium.io.checkpoint`) keep the exact state.
+
+Other tools:
+
+- OVITO opens the GSD file and the XYZ export (`write_xyz`) as they are.
+- freud: ``freud.box.Box.from_box(frame.configuration.box, dimensions=2)`` with the frame's
+  positions.
+- ASE: ``ase.io.read("run.xyz", index=":")``; velocities in ``atoms.arrays["velo"]``, charges
+  as ``atoms.get_charges()``, a walled vessel as ``pbc = False``.
+- MDAnalysis: its GSD reader takes the positions only, one time unit per frame;
+  ``universe("run.gsd")`` adds the velocities and the real time between frames.
 """
 
 from __future__ import annotations
@@ -306,6 +316,34 @@ class Trajectory:
         return int(self.mass.shape[0])
 
 
+def universe(path: str | Path) -> Any:
+    """A GSD trajectory as an MDAnalysis ``Universe`` with its velocities and frame interval.
+
+    MDAnalysis's own GSD reader takes only the positions, and counts one time unit per frame;
+    here the topology (types, masses, charges) is MDAnalysis's reading of the file, and the
+    positions and velocities (z = 0) are held in memory (``MemoryReader``) with ``dt`` the time
+    between frames and the first frame's time as offset. A periodic box has its dimensions
+    (``Lz`` the larger side: nothing moves along z); a walled vessel none, which MDAnalysis takes
+    as not periodic. Values keep collidium's units (m, s,
+    m/s), not MDAnalysis's Angstrom and ps. Needs MDAnalysis (``pip install MDAnalysis``).
+    """
+    import MDAnalysis
+    from MDAnalysis.coordinates.memory import MemoryReader
+
+    trajectory = read_trajectory(path)
+    flat = np.zeros((trajectory.frames, trajectory.n, 3), dtype=np.float32)
+    moving = flat.copy()
+    flat[..., :2] = trajectory.position
+    moving[..., :2] = trajectory.velocity
+    interval = float(np.diff(trajectory.time[:2])[0]) if trajectory.frames > 1 else 1.0
+    sides = [trajectory.width, trajectory.height]
+    box = [*sides, max(sides), 90.0, 90.0, 90.0] if trajectory.periodic else None
+    return MDAnalysis.Universe(
+        str(path), flat, format=MemoryReader, order="fac", velocities=moving, dt=interval,
+        time_offset=float(trajectory.time[0]), dimensions=box,
+    )  # fmt: skip
+
+
 def unwritten_bytes(path: Path) -> int:
     """Bytes of ``path`` in holes: ranges never written, which read back as zeros.
 
@@ -447,8 +485,10 @@ def write_xyz(trajectory: Trajectory, path: str | Path) -> None:
     """Write an extended-XYZ file (one block per frame; OVITO and ASE read it).
 
     Each block: the particle count, a comment line with ``Lattice``, ``Origin``, ``Properties``,
-    ``Time`` and ``pbc``, then one line per particle: type, x, y, z, vx, vy, vz, mass, radius,
-    charge.
+    ``Time`` and ``pbc`` (``F F F`` for a walled vessel), then one line per particle: type, Z,
+    x, y, z, vx, vy, vz, mass, radius, charge. The types (``positive``, ``negative``,
+    ``neutral``) are OVITO's particle types; ``Z`` is 0, ASE's dummy atom ``X``, since ASE reads
+    a type as a chemical symbol unless a ``Z`` column gives the atomic number.
     """
     (x0, y0), (w, h) = trajectory.vessel.bounds[0], trajectory.vessel.size
     pbc = "T T F" if trajectory.periodic else "F F F"
@@ -459,14 +499,14 @@ def write_xyz(trajectory: Trajectory, path: str | Path) -> None:
         lines.append(str(trajectory.n))
         lines.append(
             f'Lattice="{w:.17g} 0 0 0 {h:.17g} 0 0 0 1" Origin="{x0:.17g} {y0:.17g} -0.5" '
-            "Properties=species:S:1:pos:R:3:velo:R:3:mass:R:1:radius:R:1:charge:R:1 "
+            "Properties=species:S:1:Z:I:1:pos:R:3:velo:R:3:mass:R:1:radius:R:1:charge:R:1 "
             f'Time={trajectory.time[k]:.17g} Step={int(trajectory.step[k])} pbc="{pbc}"'
         )
         x, v = trajectory.position[k], trajectory.velocity[k]
         table = np.column_stack([x, zeros, v, zeros, trajectory.mass, trajectory.radius,
                                  trajectory.charge])  # fmt: skip
         lines.extend(
-            f"{name} " + " ".join(f"{value:.9g}" for value in row)
+            f"{name} 0 " + " ".join(f"{value:.9g}" for value in row)
             for name, row in zip(names, table, strict=True)
         )
     with replacing(path) as temporary:
