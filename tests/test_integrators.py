@@ -11,7 +11,7 @@ import pytest
 
 import collidium as cd
 from collidium.collisions import Contact
-from collidium.errors import InputError
+from collidium.errors import InputError, SimulationError
 from collidium.integrators import CONTACT_MARGIN, DEFAULT_TOLERANCE, AdaptiveLeapfrog, _shortened
 from collidium.observers import EnergyDrift
 
@@ -95,6 +95,15 @@ def test_shortened_substep_ends_at_a_wall_on_the_parabola():
     right = -1 - 1  # -1 - wall, wall 1 the right one
     h = _shortened(particles, cd.Box(10, 10), acceleration, Contact(0.4, 0, right), 0.0, 1.0, 0.01)
     assert h == pytest.approx((math.sqrt(3.0) - 1.0) / 2.0 - CONTACT_MARGIN * 0.01, abs=1e-15)
+
+
+def test_forces_too_strong_for_dt_stop_the_run_at_once():
+    """A Coulomb constant of 2^63 would need millions of substeps per dt (the fuzz test found it
+    taking minutes): the run stops in one line, before the first substep."""
+    sim = cd.load("charged-gas", n=20, k=2.0**63)
+    with pytest.raises(SimulationError, match="too strong for this dt"):
+        sim.run(steps=1)
+    assert sim.steps == 0
 
 
 def test_halving_the_tolerance_quarters_the_error():

@@ -20,6 +20,7 @@ from typing import Literal
 import numpy as np
 
 from collidium.collisions import Contact, Drift, Tally
+from collidium.errors import SimulationError
 from collidium.forces import ForceField
 from collidium.state import FloatArray, Particles
 from collidium.vessels import Vessel
@@ -32,8 +33,10 @@ INTEGRATORS: tuple[IntegratorName, ...] = ("adaptive", "fixed")
 #: targets at dt = 0.01 s (README); the energy error scales as its square.
 DEFAULT_TOLERANCE = 0.0007
 
-#: Most regular substeps in one reporting interval (a power of two); past it the interval is
-#: taken with this many and the energy check of the run reports the error.
+#: Most regular substeps in one reporting interval (a power of two). An interval that needs more
+#: at its start stops the run with one line (the forces are too strong for this dt, and it would
+#: take minutes); one that finds out only as it goes is taken with this many, and the energy
+#: check of the run reports the error.
 MAX_SUBSTEPS = 2**14
 
 #: The energy scale of the substep criterion is the total energy, but at least ``KE + |U|``
@@ -204,7 +207,13 @@ class AdaptiveLeapfrog(Integrator):
         tally: Tally,
     ) -> None:
         start = _Snapshot(particles, tally)
-        n = max(self.substeps, self.needed(_squared_rate(particles, vessel, field), dt))
+        rate2 = _squared_rate(particles, vessel, field)
+        if not dt * math.sqrt(rate2) <= MAX_SUBSTEPS * self.tolerance:  # also NaN
+            raise SimulationError(
+                f"the forces need more than {MAX_SUBSTEPS} substeps in one dt = {dt:g} s at "
+                f"t = {now:.6g} s: they are too strong for this dt; try a smaller dt or softening"
+            )
+        n = max(self.substeps, self.needed(rate2, dt))
         while True:
             fastest = self._interval(particles, vessel, field, drift, now, dt, tally, n)
             required = self.needed(fastest, dt)

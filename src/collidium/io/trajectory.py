@@ -324,8 +324,8 @@ def universe(path: str | Path) -> Any:
     positions and velocities (z = 0) are held in memory (``MemoryReader``) with ``dt`` the time
     between frames and the first frame's time as offset. A periodic box has its dimensions
     (``Lz`` the larger side: nothing moves along z); a walled vessel none, which MDAnalysis takes
-    as not periodic. Values keep collidium's units (m, s,
-    m/s), not MDAnalysis's Angstrom and ps. Needs MDAnalysis (``pip install MDAnalysis``).
+    as not periodic. Values keep collidium's units (m, s, m/s), not MDAnalysis's Angstrom and
+    ps. Needs MDAnalysis (``pip install MDAnalysis``).
     """
     import MDAnalysis
     from MDAnalysis.coordinates.memory import MemoryReader
