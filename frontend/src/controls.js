@@ -7,7 +7,6 @@ const SPEED_STEPS = 1000;
 const SPEED_SEND_INTERVAL_MS = 100;
 const HEAT_FACTOR = 1.25;
 const COOL_FACTOR = 0.8;
-const COLLISION_MODES = ["exact", "step", "off"];
 
 // ---------------------------------------------------------------------------------------------
 // Files
@@ -61,21 +60,30 @@ function throttle(send, interval) {
 // ---------------------------------------------------------------------------------------------
 // Control panel
 
-/** The scene overrides the panel offers, when the selected preset takes them. */
-const OVERRIDES = [
-  { name: "n", label: "N", parse: (text) => (/^\s*\d+\s*$/.test(text) ? Number(text) : NaN) },
-  { name: "dt", label: "dt (s)", parse: (text) => (text.trim() === "" ? NaN : Number(text)) },
-  { name: "k", label: "k (N m²/C²)", parse: (text) => (text.trim() === "" ? NaN : Number(text)) },
-  { name: "collisions", label: "collision mode", parse: (text) => text },
-];
+const COLOUR_LABELS = { speed: "speed", charge: "charge", species: "species" };
 
-function overrideInput(name) {
-  if (name === "collisions") {
-    return element("select", { id: "set-collisions" }, COLLISION_MODES.map((mode) => element("option", { value: mode, text: mode })));
+/** Reads a parameter field as its kind says: a number (NaN when not one), a word or a flag. */
+function parseParameter(spec, input) {
+  if (spec.kind === "boolean") return input.checked;
+  if (spec.kind === "choice") return input.value;
+  const text = input.value.trim();
+  if (spec.kind === "integer") return /^[-+]?\d+$/.test(text) ? Number(text) : NaN;
+  return text === "" ? NaN : Number(text);
+}
+
+/** The input of one preset parameter, built from the server's description of it. */
+function parameterInput(spec) {
+  const id = `set-${spec.name}`;
+  if (spec.kind === "choice") {
+    return element("select", { id }, (spec.choices ?? []).map((choice) => element("option", { value: choice, text: choice })));
   }
-  const integer = name === "n";
-  const min = name === "k" ? undefined : "0";
-  return element("input", { id: `set-${name}`, type: "number", step: integer ? "1" : "any", min, inputmode: integer ? "numeric" : "decimal" });
+  if (spec.kind === "boolean") return element("input", { id, type: "checkbox" });
+  const integer = spec.kind === "integer";
+  return element("input", { id, type: "number", step: integer ? "1" : "any", inputmode: integer ? "numeric" : "decimal" });
+}
+
+function parameterLabel(spec) {
+  return spec.unit ? `${spec.label} (${spec.unit})` : spec.label;
 }
 
 function checkbox(id, text) {
@@ -89,6 +97,8 @@ function checkbox(id, text) {
  */
 export function createControls(container, { send, report }) {
   let presets = new Map();
+  let overrideFields = [];
+  let maxParticles = Infinity;
   let speedLimits = [0.01, 100];
   let maxMessageBytes = Infinity;
   let playing = false;
@@ -96,10 +106,7 @@ export function createControls(container, { send, report }) {
 
   // Scene: preset, its overrides, Apply.
   const presetSelect = element("select", { id: "preset", title: "preset" });
-  const overrideFields = OVERRIDES.map((spec) => {
-    const input = overrideInput(spec.name);
-    return { spec, input, field: labelled(spec.label, input, "field override") };
-  });
+  const overrideBox = element("span", { className: "overrides" });
   const applyButton = element("button", { id: "apply", type: "button", text: "Apply" });
 
   // Run: play/pause, step, speed, reset, heat, cool.
@@ -115,6 +122,7 @@ export function createControls(container, { send, report }) {
   const collisionsToggle = checkbox("toggle-collisions", "collisions");
   const chargesToggle = checkbox("toggle-charges", "charges");
   const momentumToggle = checkbox("toggle-momentum", "momentum vectors");
+  const colourSelect = element("select", { id: "colour", title: "colour the disks by" });
 
   // Files.
   const downloadButton = element("button", { id: "download", type: "button", text: "Download TOML" });
@@ -128,7 +136,7 @@ export function createControls(container, { send, report }) {
   container.append(
     element("div", { className: "control-group scene-group" }, [
       labelled("preset", presetSelect),
-      ...overrideFields.map((entry) => entry.field),
+      overrideBox,
       applyButton,
     ]),
     element("div", { className: "control-group run-group" }, [
@@ -143,25 +151,27 @@ export function createControls(container, { send, report }) {
       collisionsToggle.label,
       chargesToggle.label,
       momentumToggle.label,
+      labelled("colour by", colourSelect),
     ]),
     element("div", { className: "control-group file-group" }, [downloadButton, openLabel]),
   );
 
   // --- helpers --------------------------------------------------------------------------------
 
-  function defaultsOf(name) {
-    return presets.get(name)?.parameters ?? {};
-  }
-
-  /** Shows the overrides `preset` takes, filled with its defaults overlaid by `current`. */
+  /** Shows the parameters `preset` takes (as the server describes them), filled with their
+   * defaults overlaid by `current`. */
   function fillOverrides(preset, current = {}) {
-    const defaults = defaultsOf(preset);
-    for (const { spec, input, field } of overrideFields) {
-      const taken = preset !== null && spec.name in defaults;
-      field.hidden = !taken;
-      if (taken) input.value = String(current[spec.name] ?? defaults[spec.name]);
-    }
-    applyButton.hidden = !overrideFields.some(({ field }) => !field.hidden);
+    const specs = presets.get(preset)?.parameters ?? [];
+    overrideFields = specs.map((spec) => {
+      const input = parameterInput(spec);
+      const value = current[spec.name] ?? spec.default;
+      if (spec.kind === "boolean") input.checked = Boolean(value);
+      else input.value = String(value);
+      if (spec.name === "n") input.max = String(maxParticles);
+      return { spec, input, field: labelled(parameterLabel(spec), input, "field override") };
+    });
+    overrideBox.replaceChildren(...overrideFields.map((entry) => entry.field));
+    applyButton.hidden = overrideFields.length === 0;
   }
 
   /** Selects `preset` in the list, or a placeholder for a scenario opened from a file. */
@@ -181,16 +191,15 @@ export function createControls(container, { send, report }) {
 
   /** The overrides that differ from the preset's defaults, or null after reporting a bad input. */
   function changedOverrides() {
-    const defaults = defaultsOf(presetSelect.value);
     const overrides = {};
-    for (const { spec, input, field } of overrideFields) {
-      if (field.hidden) continue;
-      const value = spec.parse(input.value);
+    for (const { spec, input } of overrideFields) {
+      const value = parseParameter(spec, input);
       if (typeof value === "number" && !Number.isFinite(value)) {
-        report(spec.name, `"${input.value}" is not a valid number`);
+        const what = spec.kind === "integer" ? "a whole number" : "a number";
+        report(spec.name, `"${input.value}" is not ${what}`);
         return null;
       }
-      if (value !== defaults[spec.name]) overrides[spec.name] = value;
+      if (value !== spec.default) overrides[spec.name] = value;
     }
     return overrides;
   }
@@ -235,6 +244,7 @@ export function createControls(container, { send, report }) {
   collisionsToggle.input.addEventListener("change", toggleSender(collisionsToggle.input, "collisions"));
   chargesToggle.input.addEventListener("change", toggleSender(chargesToggle.input, "charges"));
   momentumToggle.input.addEventListener("change", toggleSender(momentumToggle.input, "momentum"));
+  colourSelect.addEventListener("change", () => send({ type: "colour", mode: colourSelect.value }));
   downloadButton.addEventListener("click", () => send({ type: "export" }));
   openInput.addEventListener("change", () => openScenario().catch((error) => report("scenario", String(error))));
 
@@ -252,7 +262,7 @@ export function createControls(container, { send, report }) {
         speedLimits = limits.speed;
       }
       if (typeof limits.max_message_bytes === "number") maxMessageBytes = limits.max_message_bytes;
-      if (typeof limits.max_particles === "number") overrideFields[0].input.max = String(limits.max_particles);
+      if (typeof limits.max_particles === "number") maxParticles = limits.max_particles;
       fillOverrides(null);
     },
     /** Reflects the scene: its preset and overrides; charges can only be toggled if it has any. */
@@ -261,6 +271,9 @@ export function createControls(container, { send, report }) {
       fillOverrides(scene.preset ?? null, scene.overrides ?? {});
       chargesToggle.input.disabled = !scene.has_charges;
       chargesToggle.label.classList.toggle("disabled", !scene.has_charges);
+      const modes = Array.isArray(scene.colour_modes) ? scene.colour_modes : ["speed"];
+      colourSelect.replaceChildren(...modes.map((mode) => element("option", { value: mode, text: COLOUR_LABELS[mode] ?? mode })));
+      colourSelect.disabled = modes.length < 2;
     },
     /** Reflects the server's status (the slider only when the user is not holding it). */
     setStatus(status) {
@@ -270,6 +283,7 @@ export function createControls(container, { send, report }) {
       collisionsToggle.input.checked = Boolean(status.collisions);
       chargesToggle.input.checked = Boolean(status.charges);
       momentumToggle.input.checked = Boolean(status.momentum);
+      if (typeof status.colour === "string") colourSelect.value = status.colour;
       if (typeof status.speed === "number" && status.speed > 0 && !sliderHeld) {
         speedSlider.value = String(sliderFromSpeed(status.speed, speedLimits));
         speedValue.textContent = speedLabel(status.speed);

@@ -4,9 +4,19 @@
 // vectors. Buffers are reused between frames.
 import createREGL from "regl";
 
-const POSITIVE = [0xd6, 0x27, 0x28];
-const NEGATIVE = [0x1f, 0x77, 0xb4];
-const NEUTRAL = [0x7f, 0x7f, 0x7f];
+export const POSITIVE = [0xd6, 0x27, 0x28];
+export const NEGATIVE = [0x1f, 0x77, 0xb4];
+export const NEUTRAL = [0x7f, 0x7f, 0x7f];
+/** Species colours (matplotlib's tab10), in the order of the scene's species labels. */
+export const SPECIES_PALETTE = [
+  [0x1f, 0x77, 0xb4], [0xff, 0x7f, 0x0e], [0x2c, 0xa0, 0x2c], [0xd6, 0x27, 0x28], [0x94, 0x67, 0xbd],
+  [0x8c, 0x56, 0x4b], [0xe3, 0x77, 0xc2], [0x7f, 0x7f, 0x7f], [0xbc, 0xbd, 0x22], [0x17, 0xbe, 0xcf],
+];
+/** Viridis at nine evenly spaced stops, for colour by speed (0 to the scene's speed scale). */
+export const SPEED_STOPS = [
+  [68, 1, 84], [71, 44, 122], [59, 81, 139], [44, 113, 142], [33, 144, 141],
+  [39, 173, 129], [92, 200, 99], [170, 220, 50], [253, 231, 37],
+];
 const LETTERBOX = [0.91, 0.925, 0.945, 1];
 /** Point particles (radius 0) are dots of this many CSS pixels; tiny disks never go below MIN. */
 const DOT_CSS_PX = 4;
@@ -127,15 +137,40 @@ function chargeColour(charge) {
   return NEUTRAL;
 }
 
-/** Interleaved rgb + radius per particle for the `style` attribute. */
-function buildStyles(radii, charges) {
-  const styles = new Float32Array(4 * radii.length);
-  for (let i = 0; i < radii.length; i += 1) {
-    const colour = chargeColour(charges[i]);
-    for (let c = 0; c < 3; c += 1) styles[4 * i + c] = colour[c] / 255;
-    styles[4 * i + 3] = radii[i];
+/** The colour (0-255 rgb) of `fraction` of the way along the speed colormap (clamped). */
+export function speedColour(fraction) {
+  const at = Math.min(1, Math.max(0, Number.isFinite(fraction) ? fraction : 0)) * (SPEED_STOPS.length - 1);
+  const low = Math.min(Math.floor(at), SPEED_STOPS.length - 2);
+  const t = at - low;
+  return SPEED_STOPS[low].map((value, c) => value + t * (SPEED_STOPS[low + 1][c] - value));
+}
+
+/** Writes colour `rgb` (0-255) of particle `i` into the interleaved rgb + radius `styles`. */
+function setColour(styles, i, rgb) {
+  for (let c = 0; c < 3; c += 1) styles[4 * i + c] = rgb[c] / 255;
+}
+
+/** Colours every particle by charge or species (speed colours come with each frame). */
+function colourStatic(styles, mode, charges, species) {
+  const n = charges.length;
+  for (let i = 0; i < n; i += 1) {
+    const rgb = mode === "species" ? SPECIES_PALETTE[species[i] % SPECIES_PALETTE.length] : mode === "charge" ? chargeColour(charges[i]) : NEUTRAL;
+    setColour(styles, i, rgb);
   }
-  return styles;
+}
+
+/** Colours every particle by its speed as a fraction of `scale` (m/s). */
+function colourBySpeed(styles, velocities, n, scale) {
+  const steps = SPEED_STOPS.length - 1;
+  for (let i = 0; i < n; i += 1) {
+    const fraction = Math.hypot(velocities[2 * i], velocities[2 * i + 1]) / scale;
+    const at = Math.min(1, fraction) * steps;
+    const low = Math.min(Math.floor(at), steps - 1);
+    const t = at - low;
+    const a = SPEED_STOPS[low];
+    const b = SPEED_STOPS[low + 1];
+    for (let c = 0; c < 3; c += 1) styles[4 * i + c] = (a[c] + t * (b[c] - a[c])) / 255;
+  }
 }
 
 /** Median of a strided sample (exact for small n): cheap enough to run every frame. */
@@ -195,7 +230,7 @@ function createTriangleQuads(regl) {
   let capacity = 0;
   let positionData = new Float32Array(0);
   let styleData = new Float32Array(0);
-  let uploaded = { positions: null, styles: null };
+  let uploaded = { positions: null, styles: -1 };
 
   function reserve(n) {
     if (n <= capacity) return;
@@ -205,13 +240,14 @@ function createTriangleQuads(regl) {
     const corners = new Float32Array(TRIANGLE_CORNERS.length * n);
     for (let i = 0; i < n; i += 1) corners.set(TRIANGLE_CORNERS, TRIANGLE_CORNERS.length * i);
     attributes.corner({ usage: "static", type: "float", data: corners });
-    uploaded = { positions: null, styles: null };
+    uploaded = { positions: null, styles: -1 };
   }
 
-  /** Makes the buffers hold `n` disks of `positions` and `styles` (arrays compared by identity). */
-  function update(positions, styles, n) {
+  /** Makes the buffers hold `n` disks of `positions` (compared by identity) and `styles` (by
+   * `stylesVersion`, bumped at each recolouring). */
+  function update(positions, styles, stylesVersion, n) {
     reserve(n);
-    if (styles !== uploaded.styles) {
+    if (stylesVersion !== uploaded.styles) {
       repeatEach(styles, 4, n, TRIANGLE_VERTICES, styleData);
       attributes.style({ usage: "static", type: "float", data: styleData.subarray(0, 4 * TRIANGLE_VERTICES * n) });
     }
@@ -219,7 +255,7 @@ function createTriangleQuads(regl) {
       repeatEach(positions, 2, n, TRIANGLE_VERTICES, positionData);
       attributes.position({ usage: "dynamic", type: "float", data: positionData.subarray(0, 2 * TRIANGLE_VERTICES * n) });
     }
-    uploaded = { positions, styles };
+    uploaded = { positions, styles: stylesVersion };
   }
 
   return { attributes, update };
@@ -245,6 +281,12 @@ export function createDiskRenderer(canvas, viewport) {
   let lineVertices = 0;
   let masses = new Float32Array(0);
   let styles = new Float32Array(0);
+  let stylesVersion = 0;
+  let charges = new Float32Array(0);
+  let species = new Float32Array(0);
+  let colourMode = "speed";
+  let momentumShown = false;
+  let speedScale = 0;
   let shownPositions = new Float32Array(0); // the last frame's, for the triangle quads
   let typicalRadius = 0;
   let largestRadius = 0;
@@ -253,7 +295,7 @@ export function createDiskRenderer(canvas, viewport) {
   let diskPath = "points";
   const medianScratch = new Float32Array(MOMENTUM_SAMPLE);
   const positionBuffer = regl.buffer({ usage: "dynamic", type: "float", length: 8 });
-  const styleBuffer = regl.buffer({ usage: "static", type: "float", length: 16 });
+  const styleBuffer = regl.buffer({ usage: "dynamic", type: "float", length: 16 });
   const lineBuffer = regl.buffer({ usage: "dynamic", type: "float", length: 16 });
   // The vessel as the server sends it (m): its outline, stroked as a loop; the triangles that
   // fill it (any simple shape, convex or not); its partitions, stroked as separate lines.
@@ -357,12 +399,31 @@ export function createDiskRenderer(canvas, viewport) {
     outlineCorners = loadPoints(vesselOutline, scene.vessel?.outline, 1);
     fillVertices = loadPoints(vesselFill, scene.vessel?.fill, 2);
     partitionVertices = loadPoints(vesselPartitions, scene.vessel?.partition_lines, 2);
-    styles = buildStyles(radii, perParticle(scene.charge, n, 0));
-    styleBuffer({ usage: "static", type: "float", data: styles });
+    charges = perParticle(scene.charge, n, 0);
+    species = perParticle(scene.species, n, 0);
+    styles = new Float32Array(4 * n);
+    for (let i = 0; i < n; i += 1) styles[4 * i + 3] = radii[i];
+    colourStatic(styles, colourMode, charges, species);
+    uploadStyles();
     if (n !== capacity) reallocate(n);
     count = 0;
     lineVertices = 0;
     pistonShown = false;
+  }
+
+  function uploadStyles() {
+    styleBuffer({ usage: "dynamic", type: "float", data: styles });
+    stylesVersion += 1;
+  }
+
+  /** Colours by "speed" (from each frame's velocities, `scale` m/s at the top of the colormap),
+   * "charge" or "species". */
+  function setColouring(mode, scale) {
+    if (Number.isFinite(scale) && scale > 0) speedScale = scale;
+    if (mode === colourMode) return;
+    colourMode = mode;
+    colourStatic(styles, mode, charges, species);
+    uploadStyles();
   }
 
   function reallocate(n) {
@@ -382,7 +443,11 @@ export function createDiskRenderer(canvas, viewport) {
     count = frame.n;
     pistonShown = Boolean(frame.piston);
     if (pistonShown) pistonBuffer.subdata(frame.piston);
-    lineVertices = frame.velocities ? buildMomentumLines(frame.positions, frame.velocities, frame.n) : 0;
+    lineVertices = frame.velocities && momentumShown ? buildMomentumLines(frame.positions, frame.velocities, frame.n) : 0;
+    if (colourMode === "speed" && frame.velocities && speedScale > 0) {
+      colourBySpeed(styles, frame.velocities, frame.n, speedScale);
+      uploadStyles();
+    }
   }
 
   /** Segments centre -> centre + s * m v, with s making the median |m v| a couple of diameters. */
@@ -456,13 +521,18 @@ export function createDiskRenderer(canvas, viewport) {
       drawInstancedQuads(props);
     } else {
       diskPath = "triangles";
-      triangles.update(shownPositions, styles, count);
+      triangles.update(shownPositions, styles, stylesVersion, count);
       drawTriangleQuads(props);
     }
   }
 
   return {
     setScene,
+    setColouring,
+    /** Whether the momentum vectors are drawn (from the next frame with velocities). */
+    setMomentumShown(shown) {
+      momentumShown = shown;
+    },
     setFrame,
     draw,
     destroy: () => destroyContext(regl),

@@ -2,6 +2,10 @@
 // while dragging a particle to give it a new velocity. Cheap to redraw, so it is redrawn whole.
 
 const TRACE_COLOUR = "#ff7f0e";
+const HIGHLIGHT_COLOUR = "#e6a700";
+/** Charge marks are drawn on disks at least this many CSS pixels in radius, and on few disks. */
+const MARK_MIN_RADIUS_PX = 5;
+const MARK_MOST_DISKS = 5000;
 const DRAG_COLOUR = "#2b2b2b";
 const ARROW_HEAD_PX = 9;
 
@@ -9,16 +13,57 @@ export function createOverlay(canvas, viewport) {
   const context = canvas.getContext("2d");
 
   /**
-   * Draws `trace` (a trace path) with a ring around `tracedAt` = {x, y, radius} when given, and the
-   * drag arrow `drag` = {from: [x, y], to: [x, y]} in metres when given.
+   * Draws the + and - `marks` = {positions, charges, radii, n} on charged disks, the highlighted
+   * disk `highlight` = {x, y, radius, label}, `trace` (a trace path) with a ring around
+   * `tracedAt` = {x, y, radius}, and the drag arrow `drag` = {from: [x, y], to: [x, y]} in metres,
+   * each when given.
    */
-  function draw({ trace, tracedAt, drag }) {
+  function draw({ marks, highlight, trace, tracedAt, drag }) {
     const dpr = viewport.pixelRatio;
     context.setTransform(dpr, 0, 0, dpr, 0, 0);
     context.clearRect(0, 0, viewport.cssWidth, viewport.cssHeight);
+    if (marks) drawMarks(marks);
+    if (highlight) drawHighlight(highlight);
     if (trace && trace.length > 1) drawPath(trace);
     if (tracedAt) drawMarker(tracedAt);
     if (drag) drawArrow(drag.from, drag.to);
+  }
+
+  /** A white + or - across each charged disk large enough to carry one. */
+  function drawMarks({ positions, charges, radii, n }) {
+    if (n > MARK_MOST_DISKS) return;
+    context.strokeStyle = "#fff";
+    context.lineCap = "round";
+    context.beginPath();
+    for (let i = 0; i < n; i += 1) {
+      const size = radii[i] * viewport.pixelsPerMetre;
+      if (charges[i] === 0 || size < MARK_MIN_RADIUS_PX) continue;
+      const [px, py] = viewport.worldToCss(positions[2 * i], positions[2 * i + 1]);
+      const arm = 0.6 * size;
+      context.moveTo(px - arm, py);
+      context.lineTo(px + arm, py);
+      if (charges[i] > 0) {
+        context.moveTo(px, py - arm);
+        context.lineTo(px, py + arm);
+      }
+    }
+    context.lineWidth = 1.5;
+    context.stroke();
+  }
+
+  function drawHighlight({ x, y, radius, label }) {
+    const [px, py] = viewport.worldToCss(x, y);
+    const ring = radius * viewport.pixelsPerMetre + 5;
+    context.beginPath();
+    context.arc(px, py, ring, 0, 2 * Math.PI);
+    context.strokeStyle = HIGHLIGHT_COLOUR;
+    context.lineWidth = 3;
+    context.stroke();
+    if (label) {
+      context.font = "bold 12px system-ui, sans-serif";
+      context.fillStyle = "#6b4e00";
+      context.fillText(label, Math.min(px + ring + 3, viewport.cssWidth - context.measureText(label).width - 4), Math.max(py - ring, 14));
+    }
   }
 
   /** The path as one polyline, lifted where it jumps more than half the box (periodic wrap). */

@@ -8,6 +8,7 @@ import { decodeFrame } from "./frame.js";
 import { createViewport } from "./geometry.js";
 import { createMessageBar } from "./message.js";
 import { createOverlay } from "./overlay.js";
+import { createLegend } from "./legend.js";
 import { createEnergyPlot, createSpeedPlot } from "./plots.js";
 import { attachPointer } from "./pointer.js";
 import { createReadouts } from "./readouts.js";
@@ -18,7 +19,7 @@ const PICK_SLACK_PX = 3;
 const NO_WEBGL = "WebGL is not available in this browser: the disks cannot be drawn";
 
 /** Stands in for the disk renderer without WebGL, so plots, readouts, controls and acks go on. */
-const NO_RENDERER = { setScene() {}, setFrame() {}, draw() {}, destroy() {}, diskPath: null };
+const NO_RENDERER = { setScene() {}, setColouring() {}, setMomentumShown() {}, setFrame() {}, draw() {}, destroy() {}, diskPath: null };
 
 /** The static DOM: vessel (WebGL canvas + overlay), plots, readouts, controls, message bar. */
 function buildLayout(root) {
@@ -30,15 +31,17 @@ function buildLayout(root) {
   const readouts = element("div", { className: "collidium-readouts" });
   const controls = element("div", { className: "collidium-controls" });
   const message = element("div", { id: "message", role: "status", text: "connecting…" });
+  const explanation = element("p", { id: "explanation", className: "explanation", hidden: true });
   root.classList.add("collidium");
   root.replaceChildren(
     vessel,
     element("div", { className: "collidium-plots" }, [energy, speed]),
     readouts,
+    explanation,
     controls,
     message,
   );
-  return { vessel, particles, overlay, energy, speed, readouts, controls, message };
+  return { vessel, particles, overlay, energy, speed, readouts, explanation, controls, message };
 }
 
 function describeScene(scene) {
@@ -56,6 +59,7 @@ export function mountViewer(root, transport) {
   const energyPlot = createEnergyPlot(layout.energy);
   const speedPlot = createSpeedPlot(layout.speed);
   const readouts = createReadouts(layout.readouts);
+  const legend = createLegend(layout.vessel);
   const trace = createTracePath();
   const send = (message) => transport.send(message);
   const report = (field, reason) => messageBar.error(field ? `${field}: ${reason}` : reason);
@@ -70,6 +74,8 @@ export function mountViewer(root, transport) {
     stats: null,
     lastError: null,
     radii: new Float32Array(0),
+    charges: new Float32Array(0),
+    decorated: false, // charge marks or a highlighted disk: the overlay follows every frame
     framesReceived: 0,
     framesDrawn: 0,
     pendingFrame: null, // newest accepted frame not drawn yet
@@ -99,7 +105,7 @@ export function mountViewer(root, transport) {
       renderer.setFrame(frame);
       state.framesDrawn += 1;
       state.needsRedraw = true;
-      if (trace.index !== null || state.drag) state.overlayDirty = true;
+      if (trace.index !== null || state.drag || state.decorated) state.overlayDirty = true;
     }
     redraw();
     for (const seq of state.pendingAcks) send({ type: "ack", frame: seq });
@@ -124,7 +130,12 @@ export function mountViewer(root, transport) {
     const tracedAt = traced && { x: traced[0], y: traced[1], radius: state.radii[trace.index] ?? 0 };
     const dragFrom = state.drag && particleAt(state.drag.index);
     const drag = dragFrom && { from: dragFrom, to: state.drag.pointer };
-    overlay.draw({ trace, tracedAt, drag });
+    const frame = state.drawnFrame;
+    const scene = state.scene;
+    const marks = frame && scene?.has_charges && { positions: frame.positions, charges: state.charges, radii: state.radii, n: frame.n };
+    const ringed = scene && particleAt(scene.highlight ?? null);
+    const highlight = ringed && { x: ringed[0], y: ringed[1], radius: state.radii[scene.highlight] ?? 0, label: scene.highlight_label };
+    overlay.draw({ marks, highlight, trace, tracedAt, drag });
   }
 
   /** Matches both canvases to the vessel's size in device pixels and redraws at once. */
@@ -222,6 +233,10 @@ export function mountViewer(root, transport) {
     state.scene = scene;
     state.stats = null;
     state.radii = perParticle(scene.radius, scene.n | 0, 0);
+    state.charges = perParticle(scene.charge, scene.n | 0, 0);
+    state.decorated = Boolean(scene.has_charges) || Number.isInteger(scene.highlight);
+    layout.explanation.textContent = scene.explanation ?? "";
+    layout.explanation.hidden = !scene.explanation;
     state.pendingFrame = null;
     state.drawnFrame = null;
     state.drag = null;
@@ -241,8 +256,18 @@ export function mountViewer(root, transport) {
     requestRender();
   }
 
+  /** Colours the disks and shows the legend as the status and the latest stats say. */
+  function applyColouring() {
+    const mode = state.status?.colour ?? "speed";
+    const scale = state.stats?.speed_scale ?? 0;
+    renderer.setColouring(mode, scale);
+    renderer.setMomentumShown(Boolean(state.status?.momentum));
+    legend.update(mode, state.scene, scale);
+  }
+
   function applyStats(stats) {
     state.stats = stats;
+    applyColouring();
     readouts.update(stats);
     if (stats.warning && !state.warnedDrift) report("energy", stats.warning); // once a scene
     state.warnedDrift = Boolean(stats.warning);
@@ -256,6 +281,7 @@ export function mountViewer(root, transport) {
     status(message) {
       state.status = message;
       controls.setStatus(message);
+      applyColouring();
       messageBar.settle();
     },
     stats: applyStats,
@@ -345,6 +371,18 @@ export function mountViewer(root, transport) {
     },
     get status() {
       return state.status;
+    },
+    /** Where the point (x, y) m is on the vessel's canvas, in CSS pixels from its corner. */
+    toCanvas: (x, y) => viewport.worldToCss(x, y),
+    get pixelsPerMetre() {
+      return viewport.pixelsPerMetre;
+    },
+    /** Particle `i` as drawn: {x, y} in m and, when the frame has them, {vx, vy} in m/s. */
+    particle(i) {
+      const frame = state.drawnFrame;
+      if (!frame || i >= frame.n) return null;
+      const at = { x: frame.positions[2 * i], y: frame.positions[2 * i + 1] };
+      return frame.velocities ? { ...at, vx: frame.velocities[2 * i], vy: frame.velocities[2 * i + 1] } : at;
     },
     get energyPoints() {
       return energyPlot.points;

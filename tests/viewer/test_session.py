@@ -7,7 +7,7 @@ import pytest
 
 from collidium.errors import InputError, SimulationError
 from collidium.observers.thermo import Thermo
-from collidium.presets import preset
+from collidium.presets import PRESETS, preset
 from collidium.scenario import Scenario
 from collidium.theory import MaxwellBoltzmann2D
 from collidium.viewer import protocol
@@ -213,13 +213,53 @@ def test_the_histogram_is_a_density_with_the_maxwell_boltzmann_curve(gas):
     np.testing.assert_allclose(histogram["maxwell_boltzmann"], law.pdf(centres), rtol=1e-12)
 
 
-def test_frames_carry_positions_and_on_request_velocities(gas):
-    plain = protocol.decode_frame(gas.frame(4))
-    np.testing.assert_array_equal(plain["position"], gas.sim.particles.position.astype("f4"))
-    assert plain["velocity"] is None and plain["generation"] == gas.generation
-    gas.momentum = True
-    full = protocol.decode_frame(gas.frame(5))
-    np.testing.assert_array_equal(full["velocity"], gas.sim.particles.velocity.astype("f4"))
+def test_frames_carry_positions_and_velocities_when_they_are_drawn():
+    charged = ViewerSession(preset("charged-gas", n=50), preset="charged-gas")
+    assert charged.colour == "charge"  # the preset's guide says so
+    plain = protocol.decode_frame(charged.frame(4))
+    np.testing.assert_array_equal(plain["position"], charged.sim.particles.position.astype("f4"))
+    assert plain["velocity"] is None and plain["generation"] == charged.generation
+    charged.momentum = True
+    full = protocol.decode_frame(charged.frame(5))
+    np.testing.assert_array_equal(full["velocity"], charged.sim.particles.velocity.astype("f4"))
+    charged.momentum = False
+    charged.set_colour("speed")  # colours from velocities
+    assert protocol.decode_frame(charged.frame(6))["velocity"] is not None
+
+
+def test_colour_modes_are_those_that_apply(gas):
+    assert gas.scene()["colour_modes"] == ["speed"]
+    with pytest.raises(InputError, match="mode: 'charge' does not apply to this scene"):
+        gas.set_colour("charge")
+    blocks = ViewerSession(preset("pi-blocks"), preset="pi-blocks")
+    scene = blocks.scene()
+    assert scene["colour_modes"] == ["speed", "species"] and blocks.colour == "species"
+    assert scene["species"] == [0.0, 1.0] and scene["species_labels"] == [
+        "mass 1 kg",
+        "mass 1e+10 kg",
+    ]
+
+
+def test_the_hello_describes_every_presets_controls_and_explains_it(gas):
+    presets = {entry["name"]: entry for entry in gas.hello()["presets"]}
+    assert set(presets) == set(PRESETS)
+    assert all(entry["explanation"] for entry in presets.values())
+    controls = {spec["name"]: spec for spec in presets["heat-flow"]["parameters"]}
+    assert controls["hot"] == {"name": "hot", "label": "hot wall kT", "unit": "J",
+                               "default": 30.0, "kind": "number"}  # fmt: skip
+    assert controls["n"]["kind"] == "integer"
+    assert controls["boundary"]["choices"] == ["reflecting", "periodic"]
+    assert "seed" not in controls and "tolerance" not in controls
+    # Every control the page offers is one the preset takes.
+    for name, entry in presets.items():
+        for spec in entry["parameters"]:
+            preset(name, **{spec["name"]: spec["default"]})
+
+
+def test_the_cue_ball_is_the_highlighted_disk():
+    scene = ViewerSession(preset("pool-break"), preset="pool-break").scene()
+    assert scene["highlight"] == 224 and scene["highlight_label"] == "cue ball"
+    assert scene["n"] == 225
 
 
 def test_the_scene_sends_an_l_shaped_vessel_filled_and_its_partition():

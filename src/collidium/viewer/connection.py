@@ -173,6 +173,8 @@ class Connection:
             case protocol.Toggle(type="momentum", enabled=enabled):
                 s.momentum = enabled
                 s.version += 1  # the next frame carries velocities
+            case protocol.Colour(mode=mode):
+                s.set_colour(mode)
             case protocol.Reset():
                 s.reset()
                 return [s.scene(), s.status(), self._stats()]

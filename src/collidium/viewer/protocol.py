@@ -11,6 +11,7 @@ Front end to server (validated by `parse_message`; a bad one gets an ``error`` r
     speed          value: float              simulated seconds per wall-clock second
     heat           factor: float             multiply the kinetic energy (cool: factor < 1)
     collisions | charges | momentum          enabled: bool
+    colour         mode: str                 colour the disks by "speed", "charge" or "species"
     trace          index: int | null         follow a particle's path (null: none)
     set_velocity   index: int, vx, vy        m/s
     load           preset: str, overrides    a preset with its main parameters (n, dt, k,
@@ -18,10 +19,13 @@ Front end to server (validated by `parse_message`; a bad one gets an ``error`` r
     scenario       toml: str                 a scenario file's text, validated like a file
     raw            text: str                 (widget only) a message as the page would send it
 
-Server to front end (JSON): ``hello`` (version, presets, limits), ``scene`` (vessel and per-particle
-radius, charge and mass; sent again after load, scenario and reset), ``status`` (playing, speed,
-toggles), ``stats`` (time, readouts, energies, speed histogram with its Maxwell-Boltzmann curve),
-``traced``, ``export`` (filename, toml) and ``error`` (field, reason).
+Server to front end (JSON): ``hello`` (version; presets with their explanation and the controls
+of their parameters: name, label, unit, kind, default, choices; limits), ``scene`` (vessel
+outline and walls, per-particle radius, charge, mass and species, the colour modes that apply,
+the highlighted particle, the preset's explanation; sent again after load, scenario and reset),
+``status`` (playing, speed, toggles, colour mode), ``stats`` (time, readouts, energies, speed
+histogram with its Maxwell-Boltzmann curve), ``traced``, ``export`` (filename, toml) and
+``error`` (field, reason).
 
 Binary frames (little-endian): ``b"CLD1"``, u32 n, u32 flags (bit 0: velocities follow), u32
 frame number, f64 simulated time (s), u32 scene generation, u32 reserved; then float32 positions
@@ -116,6 +120,11 @@ class Toggle(_Message):
     enabled: bool
 
 
+class Colour(_Message):
+    type: Literal["colour"]
+    mode: Literal["speed", "charge", "species"]
+
+
 class Trace(_Message):
     type: Literal["trace"]
     index: Annotated[int, Field(ge=0)] | None
@@ -147,7 +156,7 @@ class Raw(_Message):
 
 
 Message = Annotated[
-    Ready | Ack | Play | Pause | Step | Reset | Export | Speed | Heat | Toggle | Trace
+    Ready | Ack | Play | Pause | Step | Reset | Export | Speed | Heat | Toggle | Colour | Trace
     | SetVelocity | Load | ScenarioText | Raw,
     Field(discriminator="type"),
 ]  # fmt: skip
@@ -155,7 +164,7 @@ _MESSAGE: TypeAdapter[Message] = TypeAdapter(Message)
 #: The ``type`` of each message the front end may send.
 MESSAGE_TYPES = (
     "ready", "ack", "play", "pause", "step", "reset", "export", "speed", "heat", "collisions",
-    "charges", "momentum", "trace", "set_velocity", "load", "scenario", "raw",
+    "charges", "momentum", "colour", "trace", "set_velocity", "load", "scenario", "raw",
 )  # fmt: skip
 
 

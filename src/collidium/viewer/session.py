@@ -22,9 +22,10 @@ from collidium.observers.thermo import Thermo
 from collidium.presets import PRESETS, describe_presets, preset
 from collidium.scenario import Scenario
 from collidium.simulation import Simulation
-from collidium.state import FloatArray, uniform_or_each
+from collidium.state import FloatArray, Particles, uniform_or_each
 from collidium.viewer import protocol
 from collidium.viewer.builder import BUILDER
+from collidium.viewer.guide import ColourMode, guide, parameter_specs
 
 #: Bins of the live speed histogram.
 HISTOGRAM_BINS = 30
@@ -32,8 +33,6 @@ HISTOGRAM_BINS = 30
 WINDOW_SAMPLES = 5
 #: Longest wall-clock gap one `advance` makes up for, s (longer pauses are not caught up).
 MAX_CATCH_UP = 0.25
-#: Main parameters the page offers for a preset, when the preset takes them.
-MAIN_PARAMETERS = ("n", "dt", "k", "collisions")
 #: A step that takes longer than this, in s, pauses the session with an error (dt or N is too
 #: large for a live view).
 MAX_STEP_SECONDS = 2.0
@@ -97,6 +96,11 @@ class ViewerSession:
         self._mode = sim.collisions if sim.collisions != "off" else "exact"
         self._forces = sim.forces
         self.traced: int | None = None
+        self._species, self._species_labels = _species(sim.particles)
+        self.colour: ColourMode = self._colour_modes()[0]
+        wanted = guide(name).colour
+        if wanted in self._colour_modes():
+            self.colour = wanted
         self.generation += 1
         self._carry = 0.0
         # Measured on the second step: the first also loads the kernels (the scenario was
@@ -192,6 +196,25 @@ class ViewerSession:
         """Whether the scenario's forces act."""
         return bool(self.sim.forces)
 
+    def set_colour(self, mode: ColourMode) -> None:
+        """Colour the disks by ``mode``: "speed", "charge" or "species" (see `_colour_modes`)."""
+        if mode not in self._colour_modes():
+            offered = ", ".join(self._colour_modes())
+            raise InputError(
+                "mode", f"{mode!r} does not apply to this scene; choose from {offered}"
+            )
+        self.colour = mode
+        self.version += 1  # the next frame carries velocities (or stops carrying them)
+
+    def _colour_modes(self) -> list[ColourMode]:
+        """Speed always; charge when some disk is charged; species when there are several."""
+        modes: list[ColourMode] = ["speed"]
+        if np.any(self.sim.particles.charge != 0):
+            modes.append("charge")
+        if len(self._species_labels) > 1:
+            modes.append("species")
+        return modes
+
     def _check_index(self, index: int) -> None:
         n = self.sim.particles.n
         if index >= n:
@@ -254,11 +277,8 @@ class ViewerSession:
             {
                 "name": entry["name"],
                 "description": entry["description"],
-                "parameters": {
-                    key: value
-                    for key, value in entry["parameters"].items()
-                    if key in MAIN_PARAMETERS
-                },
+                "explanation": guide(entry["name"]).explanation,
+                "parameters": parameter_specs(entry["parameters"]),
             }
             for entry in describe_presets()
         ]
@@ -276,6 +296,10 @@ class ViewerSession:
         sim = self.sim
         p = sim.particles
         vessel = sim.container
+        notes = guide(self._preset)
+        highlight = None
+        if notes.highlight is not None and -p.n <= notes.highlight < p.n:
+            highlight = notes.highlight % p.n
         return {
             "type": "scene", "generation": self.generation, "name": sim.name,
             "preset": self._preset, "overrides": self._overrides, "n": p.n,
@@ -289,6 +313,10 @@ class ViewerSession:
             "radius": _compact(p.radius), "charge": _compact(p.charge),
             "mass": _compact(p.mass), "dt": sim.dt, "collisions": self._mode,
             "has_charges": bool(self._forces) and bool(np.any(p.charge != 0)),
+            "species": _compact(self._species.astype(float)) if p.n else 0.0,
+            "species_labels": self._species_labels, "colour_modes": self._colour_modes(),
+            "explanation": notes.explanation, "highlight": highlight,
+            "highlight_label": notes.highlight_label if highlight is not None else "",
         }  # fmt: skip
 
     def status(self) -> dict[str, Any]:
@@ -296,7 +324,7 @@ class ViewerSession:
         return {
             "type": "status", "playing": self.playing, "speed": self.speed,
             "collisions": self.collisions_enabled, "charges": self.charges_enabled,
-            "momentum": self.momentum,
+            "momentum": self.momentum, "colour": self.colour,
         }  # fmt: skip
 
     def stats(self) -> dict[str, Any]:
@@ -320,6 +348,7 @@ class ViewerSession:
             "energy": {"kinetic": _number(energy.kinetic), "potential": _number(energy.potential),
                        "total": _number(energy.total)},
             "total_speed": _number(sim.total_speed()), "histogram": self._histogram(kT),
+            "speed_scale": 0.5 * self._upper_speed or None,
         }  # fmt: skip
 
     def _sample_window(self) -> None:
@@ -360,13 +389,14 @@ class ViewerSession:
         }
 
     def frame(self, number: int) -> bytes:
-        """The binary frame of the current state (velocities included with momentum on, the
-        piston's face with a piston)."""
+        """The binary frame of the current state (velocities included with momentum on or
+        colour by speed, the piston's face with a piston)."""
         p = self.sim.particles
         piston = self.sim.piston()
         line = None if piston is None else self.sim.container.piston_line(piston.position)
+        velocities = self.momentum or self.colour == "speed"
         return protocol.encode_frame(number, self.sim.time, self.generation, p.position,
-                                     p.velocity if self.momentum else None, line)  # fmt: skip
+                                     p.velocity if velocities else None, line)  # fmt: skip
 
     def export(self) -> dict[str, Any]:
         """The scenario that reset returns to, as TOML, with a file name."""
@@ -382,6 +412,24 @@ def _check_size(n: int, forces: bool, field: str) -> None:
     if n > most:
         what = " with forces" if forces else ""
         raise InputError(field, f"{n} particles; the viewer takes at most {most}{what}")
+
+
+def _species(particles: Particles) -> tuple[np.ndarray, list[str]]:
+    """Each particle's species (the index of its distinct mass, radius and charge) and a label
+    for each species naming what sets it apart."""
+    if particles.n == 0:
+        return np.zeros(0, dtype=np.int64), []
+    fields = (("mass", "kg"), ("radius", "m"), ("charge", "C"))
+    table = np.column_stack(
+        [np.broadcast_to(getattr(particles, f), (particles.n,)) for f, _ in fields]
+    )
+    kinds, index = np.unique(table, axis=0, return_inverse=True)
+    differing = [j for j in range(len(fields)) if np.unique(kinds[:, j]).size > 1]
+    labels = [
+        ", ".join(f"{fields[j][0]} {kind[j]:g} {fields[j][1]}" for j in differing) or "all"
+        for kind in kinds
+    ]
+    return index.reshape(-1), labels
 
 
 def _compact(values: FloatArray) -> float | list[float]:
