@@ -60,6 +60,10 @@ function throttle(send, interval) {
 // ---------------------------------------------------------------------------------------------
 // Control panel
 
+/** Holding "heat" or "cool" keeps the walls at this many times the gas's kT. */
+const HOLD_FACTORS = { heat: 2, cool: 0.5 };
+/** Readouts the speed histogram may be averaged over. */
+const HISTOGRAM_WINDOWS = [1, 5, 20, 50];
 const COLOUR_LABELS = { speed: "speed", charge: "charge", species: "species" };
 
 /** Reads a parameter field as its kind says: a number (NaN when not one), a word or a flag. */
@@ -95,7 +99,7 @@ function checkbox(id, text) {
  * Builds the panel in `container`. `send(message)` sends to the server; `report(field, reason)`
  * shows a problem found before sending. Returns setters for hello, scene and status.
  */
-export function createControls(container, { send, report }) {
+export function createControls(container, { send, report, temperature }) {
   let presets = new Map();
   let overrideFields = [];
   let maxParticles = Infinity;
@@ -117,6 +121,10 @@ export function createControls(container, { send, report }) {
   const resetButton = element("button", { id: "reset", type: "button", text: "Reset" });
   const heatButton = element("button", { id: "heat", type: "button", text: "Heat", title: "kinetic energy × 1.25" });
   const coolButton = element("button", { id: "cool", type: "button", text: "Cool", title: "kinetic energy × 0.8" });
+  const holdHeatButton = element("button", { id: "hold-heat", type: "button", text: "Hold: hot walls", title: "while held, the walls are at twice the gas's kT" });
+  const holdCoolButton = element("button", { id: "hold-cool", type: "button", text: "Hold: cold walls", title: "while held, the walls are at half the gas's kT" });
+  const histogramSelect = element("select", { id: "histogram-window", title: "average the speed histogram over the last readouts" },
+    HISTOGRAM_WINDOWS.map((count) => element("option", { value: String(count), text: count === 1 ? "now" : `last ${count}` })));
 
   // Display and physics toggles.
   const collisionsToggle = checkbox("toggle-collisions", "collisions");
@@ -146,12 +154,15 @@ export function createControls(container, { send, report }) {
       resetButton,
       heatButton,
       coolButton,
+      holdHeatButton,
+      holdCoolButton,
     ]),
     element("div", { className: "control-group toggle-group" }, [
       collisionsToggle.label,
       chargesToggle.label,
       momentumToggle.label,
       labelled("colour by", colourSelect),
+      labelled("histogram", histogramSelect),
     ]),
     element("div", { className: "control-group file-group" }, [downloadButton, openLabel]),
   );
@@ -244,6 +255,25 @@ export function createControls(container, { send, report }) {
   collisionsToggle.input.addEventListener("change", toggleSender(collisionsToggle.input, "collisions"));
   chargesToggle.input.addEventListener("change", toggleSender(chargesToggle.input, "charges"));
   momentumToggle.input.addEventListener("change", toggleSender(momentumToggle.input, "momentum"));
+  let holding = false;
+  function hold(kind) {
+    const kT = temperature();
+    if (!(kT > 0)) {
+      report("temperature", "the gas has no temperature to hold the walls near; give a disk a velocity first");
+      return;
+    }
+    holding = true;
+    send({ type: "wall_temperature", temperature: HOLD_FACTORS[kind] * kT });
+  }
+  function release() {
+    if (holding) send({ type: "wall_temperature", temperature: null });
+    holding = false;
+  }
+  for (const [button, kind] of [[holdHeatButton, "heat"], [holdCoolButton, "cool"]]) {
+    button.addEventListener("pointerdown", () => hold(kind));
+    for (const name of ["pointerup", "pointerleave", "pointercancel"]) button.addEventListener(name, release);
+  }
+  histogramSelect.addEventListener("change", () => send({ type: "histogram_window", readouts: Number(histogramSelect.value) }));
   colourSelect.addEventListener("change", () => send({ type: "colour", mode: colourSelect.value }));
   downloadButton.addEventListener("click", () => send({ type: "export" }));
   openInput.addEventListener("change", () => openScenario().catch((error) => report("scenario", String(error))));
@@ -284,6 +314,11 @@ export function createControls(container, { send, report }) {
       chargesToggle.input.checked = Boolean(status.charges);
       momentumToggle.input.checked = Boolean(status.momentum);
       if (typeof status.colour === "string") colourSelect.value = status.colour;
+      if (typeof status.histogram_window === "number") histogramSelect.value = String(status.histogram_window);
+      const held = typeof status.wall_temperature === "number";
+      holdHeatButton.classList.toggle("held", held && holding);
+      holdCoolButton.classList.toggle("held", held && holding);
+      for (const button of [holdHeatButton, holdCoolButton]) button.disabled = status.has_walls === false;
       if (typeof status.speed === "number" && status.speed > 0 && !sliderHeld) {
         speedSlider.value = String(sliderFromSpeed(status.speed, speedLimits));
         speedValue.textContent = speedLabel(status.speed);

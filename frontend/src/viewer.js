@@ -8,6 +8,7 @@ import { decodeFrame } from "./frame.js";
 import { createViewport } from "./geometry.js";
 import { createMessageBar } from "./message.js";
 import { createOverlay } from "./overlay.js";
+import { createInstruments } from "./instruments.js";
 import { createLegend } from "./legend.js";
 import { createEnergyPlot, createSpeedPlot } from "./plots.js";
 import { attachPointer } from "./pointer.js";
@@ -16,6 +17,7 @@ import { createTracePath } from "./trace.js";
 
 /** Extra reach, in CSS pixels, around a disk when clicking on it. */
 const PICK_SLACK_PX = 3;
+const STARTING = "starting… (the first run on this machine compiles the simulation's kernels: up to half a minute)";
 const NO_WEBGL = "WebGL is not available in this browser: the disks cannot be drawn";
 
 /** Stands in for the disk renderer without WebGL, so plots, readouts, controls and acks go on. */
@@ -29,19 +31,20 @@ function buildLayout(root) {
   const energy = element("div", { id: "energy-plot", className: "plot" });
   const speed = element("div", { id: "speed-plot", className: "plot" });
   const readouts = element("div", { className: "collidium-readouts" });
+  const instruments = element("div", { id: "instruments", className: "collidium-instruments" });
   const controls = element("div", { className: "collidium-controls" });
   const message = element("div", { id: "message", role: "status", text: "connecting…" });
   const explanation = element("p", { id: "explanation", className: "explanation", hidden: true });
   root.classList.add("collidium");
   root.replaceChildren(
     vessel,
-    element("div", { className: "collidium-plots" }, [energy, speed]),
+    element("div", { className: "collidium-plots" }, [instruments, energy, speed]),
     readouts,
     explanation,
     controls,
     message,
   );
-  return { vessel, particles, overlay, energy, speed, readouts, explanation, controls, message };
+  return { vessel, particles, overlay, energy, speed, readouts, instruments, explanation, controls, message };
 }
 
 function describeScene(scene) {
@@ -60,10 +63,12 @@ export function mountViewer(root, transport) {
   const speedPlot = createSpeedPlot(layout.speed);
   const readouts = createReadouts(layout.readouts);
   const legend = createLegend(layout.vessel);
+  const instruments = createInstruments(layout.instruments);
   const trace = createTracePath();
   const send = (message) => transport.send(message);
   const report = (field, reason) => messageBar.error(field ? `${field}: ${reason}` : reason);
-  const controls = createControls(layout.controls, { send, report });
+  const temperature = () => state.stats?.temperature ?? null;
+  const controls = createControls(layout.controls, { send, report, temperature });
 
   const state = {
     connected: false,
@@ -248,6 +253,7 @@ export function mountViewer(root, transport) {
     energyPlot.clear();
     speedPlot.clear();
     readouts.reset(scene.n);
+    instruments.reset();
     controls.setScene(scene);
     messageBar.neutral(describeScene(scene));
     messageBar.settle();
@@ -269,6 +275,7 @@ export function mountViewer(root, transport) {
     state.stats = stats;
     applyColouring();
     readouts.update(stats);
+    instruments.update(stats);
     if (stats.warning && !state.warnedDrift) report("energy", stats.warning); // once a scene
     state.warnedDrift = Boolean(stats.warning);
     energyPlot.append(stats);
@@ -279,9 +286,13 @@ export function mountViewer(root, transport) {
     hello: (message) => controls.setHello(message),
     scene: applyScene,
     status(message) {
+      const wasStarting = state.status?.phase === "starting";
       state.status = message;
       controls.setStatus(message);
       applyColouring();
+      layout.vessel.classList.toggle("starting", message.phase === "starting");
+      if (message.phase === "starting") messageBar.neutral(STARTING);
+      else if (wasStarting && state.scene) messageBar.neutral(describeScene(state.scene));
       messageBar.settle();
     },
     stats: applyStats,

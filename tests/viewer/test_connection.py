@@ -45,6 +45,20 @@ def test_nothing_is_sent_before_ready_and_ready_gets_the_handshake(connection):
     assert kinds(connection.tick()) == ["frame"]
 
 
+def test_the_page_hears_when_the_first_step_has_run(connection, clock):
+    """The first step compiles the kernels on a fresh installation: the page says "starting"
+    until a status says the simulation runs."""
+    ready = connection.receive({"type": "ready"})
+    assert [item["phase"] for item in ready if item["type"] == "status"] == ["starting"]
+    clock.now += 0.05
+    sent = connection.tick()
+    assert [
+        item["phase"] for item in sent if isinstance(item, dict) and item["type"] == "status"
+    ] == ["running"]
+    clock.now += 0.05
+    assert "status" not in kinds(connection.tick())  # said once
+
+
 def test_frames_wait_for_acknowledgement_and_carry_the_latest_state(connection, clock):
     connection.receive({"type": "ready"})
     frames = []

@@ -433,3 +433,50 @@ def test_the_parameters_and_the_explanation_come_from_the_server(page):
     page.fill("#set-n", "12.5")  # not a whole number: said, not sent
     page.click("#apply")
     assert page.inner_text("#message").startswith('n: "12.5" is not a whole number')
+
+
+def test_holding_hot_walls_warms_the_gas_on_the_thermometer(page):
+    page.wait_for_function(
+        "window.collidiumViewer.stats && window.collidiumViewer.stats.temperature > 0"
+    )
+    before = readout(page, "temperature")
+    page.hover("#hold-heat")
+    page.mouse.down()
+    page.wait_for_function("window.collidiumViewer.status.wall_temperature !== null")
+    assert page.evaluate("window.collidiumViewer.status.wall_temperature") == pytest.approx(
+        2 * before,
+        rel=0.1,  # twice kT at the moment of pressing (a readout later)
+    )
+    page.wait_for_function(
+        f"window.collidiumViewer.stats.temperature > {1.3 * before}", timeout=30_000
+    )
+    page.mouse.up()
+    page.wait_for_function("window.collidiumViewer.status.wall_temperature === null")
+    assert page.inner_text("#thermometer-value").startswith("kT ")
+    assert "±" in page.inner_text("#gauge-value")
+
+
+def test_the_histogram_can_average_over_readouts_and_a_picked_disk_is_described(page):
+    page.select_option("#histogram-window", "20")
+    page.wait_for_function("window.collidiumViewer.status.histogram_window === 20")
+    page.wait_for_function("window.collidiumViewer.stats.histogram.readouts >= 3")
+    page.evaluate("window.collidiumViewer.send({type: 'trace', index: 5})")
+    page.wait_for_function(
+        "window.collidiumViewer.stats.traced && window.collidiumViewer.stats.traced.index === 5"
+    )
+    assert page.inner_text("#picked").startswith("disk 5: speed ")
+
+
+def test_every_preset_opens_with_its_explanation_and_is_saved_as_a_screenshot(page, artifacts):
+    from collidium.presets import PRESETS
+    from collidium.viewer.guide import GUIDES
+
+    for name in PRESETS:
+        load_preset(page, name)
+        page.wait_for_timeout(300)
+        assert page.evaluate("window.collidiumViewer.lastError") is None, name
+        assert page.inner_text("#explanation") == GUIDES[name].explanation
+        assert page.evaluate("window.collidiumViewer.status.phase") == "running"
+        target = artifacts / f"viewer-{name}.png"
+        page.screenshot(path=str(target))
+        assert target.stat().st_size > 10_000

@@ -196,6 +196,7 @@ def test_pressure_and_collision_rate_are_window_averages(gas):
             stats = gas.stats()
         assert stats["pressure_kind"] == "wall"
         assert stats["pressure"] == pytest.approx(thermo.wall_pressure()["total"], rel=1e-12)
+        assert stats["pressure_error"] == pytest.approx(thermo.wall_pressure_error(), rel=1e-12)
         expected = (gas.sim.counters.pair_collisions - pairs) / (gas.sim.time - start)
         assert stats["collision_rate"] == pytest.approx(expected, rel=1e-12)
 
@@ -301,3 +302,57 @@ def test_a_step_too_slow_to_watch_pauses_but_the_first_is_not_judged(gas, monkey
     with pytest.raises(SimulationError, match="too slow to watch"):
         gas.advance(0.01, budget=10.0)
     assert not gas.playing
+
+
+def test_walls_held_hot_heat_the_gas_and_are_given_back(gas):
+    own = gas.sim.container
+    kT = gas.sim.temperature()
+    gas.hold_wall_temperature(3 * kT)
+    assert gas.status()["wall_temperature"] == 3 * kT
+    gas.sim.run(time=20.0)
+    # The gas takes the walls' temperature (statistical spread of 100 disks: a few percent).
+    assert gas.sim.temperature() == pytest.approx(3 * kT, rel=0.15)
+    assert abs(gas.stats()["drift"]) < 1e-9  # the heat the walls gave is counted, not drift
+    gas.hold_wall_temperature(None)
+    assert gas.sim.container is own and gas.status()["wall_temperature"] is None
+
+
+def test_a_piston_stays_a_piston_while_the_walls_are_held_and_a_periodic_box_refuses():
+    piston = ViewerSession(preset("piston", n=50), preset="piston")
+    wall = piston.sim.container.piston[0]
+    piston.hold_wall_temperature(1.0)
+    walls = piston.sim.container.walls
+    name = piston.sim.container.wall_names[wall]
+    assert type(walls[name]).__name__ == "Piston"
+    assert {type(r).__name__ for n, r in walls.items() if n != name} == {"Thermal"}
+    assert piston.stats()["piston"]["position"] == piston.sim.piston().position
+    periodic = ViewerSession(preset("granular", n=50), preset="granular")
+    assert periodic.status()["has_walls"] is False
+    with pytest.raises(InputError, match="temperature: a periodic box has no walls"):
+        periodic.hold_wall_temperature(1.0)
+
+
+def test_the_histogram_averages_the_last_readouts_with_the_same_bins(gas):
+    gas.set_histogram_window(3)
+    densities = []
+    for _ in range(4):
+        gas.sim.run(steps=5)
+        stats = gas.stats()
+        gas.stats()  # the same moment again (paused) is not counted twice
+        edges = np.array(stats["histogram"]["edges"])
+        densities.append(np.histogram(np.hypot(*gas.sim.particles.velocity.T), edges)[0])
+    histogram = stats["histogram"]
+    assert histogram["readouts"] == 3
+    widths = np.diff(edges)
+    expected = np.mean([counts / (100 * widths) for counts in densities[-3:]], axis=0)
+    np.testing.assert_allclose(histogram["density"], expected, rtol=1e-12, atol=1e-15)
+
+
+def test_the_followed_disk_is_described(gas):
+    gas.trace(7)
+    traced = gas.stats()["traced"]
+    speed = float(np.hypot(*gas.sim.particles.velocity[7]))
+    assert traced["index"] == 7 and traced["speed"] == pytest.approx(speed, rel=1e-15)
+    assert traced["kinetic"] == pytest.approx(0.5 * speed**2, rel=1e-15)  # m = 1 kg
+    gas.trace(None)
+    assert gas.stats()["traced"] is None

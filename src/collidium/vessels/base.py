@@ -379,6 +379,12 @@ class Vessel(ABC):
         walls = {name: response_to_dict(response) for name, response in self.walls.items()}
         return out | ({"walls": walls} if walls else {})
 
+    def with_walls(self, responses: dict[str, WallResponse]) -> Vessel:
+        """The same vessel with the walls named in ``responses`` given those responses (a
+        ``Specular()`` makes one a mirror again); the others keep theirs."""
+        return type(self)(**self.parameters(), walls=self.walls | responses,
+                          partitions=self.partitions)  # fmt: skip
+
     def wrap(self, position: FloatArray) -> FloatArray:
         """Positions mapped into the primary cell of a periodic vessel; an unchanged copy
         otherwise."""

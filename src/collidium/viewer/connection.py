@@ -95,6 +95,7 @@ class Connection:
         if self._credit == 0 and now - self._last_ack > STALL_SECONDS:
             return []  # nobody is watching: wait
         out: list[Outgoing] = []
+        starting = self.session.status()["phase"] == "starting"
         try:
             self.session.advance(elapsed, self.budget)
         except SimulationError as exc:
@@ -106,6 +107,8 @@ class Connection:
                     self.session.status()]  # fmt: skip
         if self._credit > 0 and self.session.version != self._framed:
             out.append(self._frame())
+        if starting and self.session.status()["phase"] == "running":
+            out.append(self.session.status())  # the page stops saying "starting"
         if now - self._last_stats >= STATS_PERIOD and self.session.version != self._reported:
             out.append(self._stats())
         return out
@@ -175,6 +178,10 @@ class Connection:
                 s.version += 1  # the next frame carries velocities
             case protocol.Colour(mode=mode):
                 s.set_colour(mode)
+            case protocol.WallTemperature(temperature=kT):
+                s.hold_wall_temperature(kT)
+            case protocol.HistogramWindow(readouts=readouts):
+                s.set_histogram_window(readouts)
             case protocol.Reset():
                 s.reset()
                 return [s.scene(), s.status(), self._stats()]

@@ -12,6 +12,9 @@ Front end to server (validated by `parse_message`; a bad one gets an ``error`` r
     heat           factor: float             multiply the kinetic energy (cool: factor < 1)
     collisions | charges | momentum          enabled: bool
     colour         mode: str                 colour the disks by "speed", "charge" or "species"
+    wall_temperature  temperature: float | null  hold the walls at kT (J) (heat or cool
+                                             continuously); null gives them back
+    histogram_window  readouts: int          average the speed histogram over the last readouts
     trace          index: int | null         follow a particle's path (null: none)
     set_velocity   index: int, vx, vy        m/s
     load           preset: str, overrides    a preset with its main parameters (n, dt, k,
@@ -63,6 +66,10 @@ MESSAGE_BURST = 100
 SPEED_RANGE = (0.01, 100.0)
 #: Range of the factor by which heat multiplies the kinetic energy.
 HEAT_RANGE = (0.1, 10.0)
+#: Hottest a wall may be held, kT in J.
+MAX_WALL_TEMPERATURE = 1e12
+#: Most readouts the speed histogram may be averaged over.
+MAX_HISTOGRAM_WINDOW = 50
 #: Fastest speed a particle may be given by dragging, m/s.
 MAX_SET_SPEED = 1e6
 
@@ -125,6 +132,16 @@ class Colour(_Message):
     mode: Literal["speed", "charge", "species"]
 
 
+class WallTemperature(_Message):
+    type: Literal["wall_temperature"]
+    temperature: Annotated[float, Field(gt=0, le=MAX_WALL_TEMPERATURE, allow_inf_nan=False)] | None
+
+
+class HistogramWindow(_Message):
+    type: Literal["histogram_window"]
+    readouts: Annotated[int, Field(ge=1, le=MAX_HISTOGRAM_WINDOW)]
+
+
 class Trace(_Message):
     type: Literal["trace"]
     index: Annotated[int, Field(ge=0)] | None
@@ -156,7 +173,8 @@ class Raw(_Message):
 
 
 Message = Annotated[
-    Ready | Ack | Play | Pause | Step | Reset | Export | Speed | Heat | Toggle | Colour | Trace
+    Ready | Ack | Play | Pause | Step | Reset | Export | Speed | Heat | Toggle | Colour
+    | WallTemperature | HistogramWindow | Trace
     | SetVelocity | Load | ScenarioText | Raw,
     Field(discriminator="type"),
 ]  # fmt: skip
@@ -164,7 +182,8 @@ _MESSAGE: TypeAdapter[Message] = TypeAdapter(Message)
 #: The ``type`` of each message the front end may send.
 MESSAGE_TYPES = (
     "ready", "ack", "play", "pause", "step", "reset", "export", "speed", "heat", "collisions",
-    "charges", "momentum", "colour", "trace", "set_velocity", "load", "scenario", "raw",
+    "charges", "momentum", "colour", "wall_temperature", "histogram_window", "trace",
+    "set_velocity", "load", "scenario", "raw",
 )  # fmt: skip
 
 

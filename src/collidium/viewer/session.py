@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import re
 import time as clock
+from collections import deque
 from typing import Any
 
 import numpy as np
@@ -23,13 +24,16 @@ from collidium.presets import PRESETS, describe_presets, preset
 from collidium.scenario import Scenario
 from collidium.simulation import Simulation
 from collidium.state import FloatArray, Particles, uniform_or_each
+from collidium.theory import MaxwellBoltzmann2D
+from collidium.vessels.walls import Thermal
 from collidium.viewer import protocol
 from collidium.viewer.builder import BUILDER
 from collidium.viewer.guide import ColourMode, guide, parameter_specs
 
 #: Bins of the live speed histogram.
 HISTOGRAM_BINS = 30
-#: Pressure and collision rate are averages over this many intervals between stats samples.
+#: Pressure and collision rate are averages over this many intervals between stats samples (the
+#: pressure's error is that of their block average).
 WINDOW_SAMPLES = 5
 #: Longest wall-clock gap one `advance` makes up for, s (longer pauses are not caught up).
 MAX_CATCH_UP = 0.25
@@ -96,6 +100,14 @@ class ViewerSession:
         self._mode = sim.collisions if sim.collisions != "off" else "exact"
         self._forces = sim.forces
         self.traced: int | None = None
+        #: kT (J) of the thermal walls held while heating or cooling continuously, or None.
+        self.wall_temperature: float | None = None
+        self._vessel = sim.container  # with its own walls, given back when the hold ends
+        self.histogram_window = 1
+        # (upper speed, density, time, kT) of the last readouts' histograms
+        self._histograms: deque[tuple[float, FloatArray, float, float]] = deque(
+            maxlen=protocol.MAX_HISTOGRAM_WINDOW
+        )
         self._species, self._species_labels = _species(sim.particles)
         self.colour: ColourMode = self._colour_modes()[0]
         wanted = guide(name).colour
@@ -116,6 +128,7 @@ class ViewerSession:
         self._worst_drift = 0.0  # largest relative energy drift since
         self._thermo = Thermo()
         self._pressure: float | None = None
+        self._pressure_error: float | None = None
         self._rate: float | None = None
         self._window: tuple[float, int] | None = None
         self.version += 1
@@ -161,6 +174,29 @@ class ViewerSession:
         """Multiply the kinetic energy by ``factor`` (velocities by its square root)."""
         self.sim.particles.velocity *= math.sqrt(factor)
         self._changed()
+
+    def hold_wall_temperature(self, kT: float | None) -> None:
+        """Make the vessel's walls thermal walls at ``kT`` (J), heating or cooling the gas
+        continuously through them, until called with None, which gives the walls back their
+        own responses (a piston stays a piston). The energy they exchange is counted as wall
+        heat, so the energy drift readout stays that of the dynamics."""
+        vessel = self._vessel
+        if kT is None:
+            self.sim.container = vessel
+        else:
+            piston = vessel.piston
+            walls = [name for k, name in enumerate(vessel.shape_walls)
+                     if piston is None or k != piston[0]]  # fmt: skip
+            if not walls:
+                raise InputError("temperature", "a periodic box has no walls to heat through; "
+                                 "use the heat and cool buttons")  # fmt: skip
+            self.sim.container = vessel.with_walls({name: Thermal(kT) for name in walls})
+        self.wall_temperature = kT
+
+    def set_histogram_window(self, readouts: int) -> None:
+        """Average the speed histogram over the last ``readouts`` stats messages (1: none)."""
+        self.histogram_window = readouts
+        self.version += 1
 
     def enable_collisions(self, enabled: bool) -> None:
         """Collisions between disks on (the scenario's mode) or off (walls still reflect)."""
@@ -320,11 +356,15 @@ class ViewerSession:
         }  # fmt: skip
 
     def status(self) -> dict[str, Any]:
-        """Playing, speed and the toggles."""
+        """Playing, speed, the toggles, and the phase: "starting" until the first step has run
+        (on a fresh installation it compiles the kernels, for up to half a minute)."""
         return {
             "type": "status", "playing": self.playing, "speed": self.speed,
             "collisions": self.collisions_enabled, "charges": self.charges_enabled,
             "momentum": self.momentum, "colour": self.colour,
+            "wall_temperature": self.wall_temperature, "histogram_window": self.histogram_window,
+            "has_walls": bool(self._vessel.shape_walls),
+            "phase": "running" if self._loaded else "starting",
         }  # fmt: skip
 
     def stats(self) -> dict[str, Any]:
@@ -342,6 +382,8 @@ class ViewerSession:
         return {
             "type": "stats", "time": sim.time, "steps": sim.steps, "n": n,
             "temperature": _number(kT), "pressure": self._pressure,
+            "pressure_error": self._pressure_error, "piston": self._piston(),
+            "traced": self._traced(),
             "pressure_kind": "virial" if sim.container.periodic else "wall",
             "collision_rate": self._rate, "drift": _number(drift),
             "warning": drift_warning(self._worst_drift),
@@ -367,26 +409,61 @@ class ViewerSession:
         start, pairs = self._window
         if sim.container.periodic:
             self._pressure = _number(self._thermo.virial_pressure())
+            self._pressure_error = _number(self._thermo.virial_pressure_error())
         else:
             self._pressure = _number(self._thermo.wall_pressure()["total"])
+            self._pressure_error = _number(self._thermo.wall_pressure_error())
         self._rate = (sim.counters.pair_collisions - pairs) / (sim.time - start)
         self._window = (sim.time, sim.counters.pair_collisions)
         self._thermo.compute(sim)
 
     def _histogram(self, kT: float | None) -> dict[str, Any]:
+        """The speed histogram, averaged over the last `histogram_window` readouts taken with the
+        same bins, and the Maxwell-Boltzmann density at their mean temperature."""
         sim = self.sim
         scale = math.sqrt(kT / float(sim.particles.mass.min())) if kT and kT > 0 else math.nan
         if not math.isfinite(scale) or scale == 0:
-            return {"edges": [], "density": [], "maxwell_boltzmann": None}
+            return {"edges": [], "density": [], "maxwell_boltzmann": None, "readouts": 0}
         if not scale * 4 <= self._upper_speed <= scale * 10:
             self._upper_speed = _nice_ceiling(5 * scale)
         histogram = SpeedHistogram(HISTOGRAM_BINS, (0.0, self._upper_speed)).compute(sim)
-        curve = histogram.maxwell_boltzmann().pdf(histogram.bin_centers)
+        recent = self._histograms
+        if recent and recent[-1][0] != self._upper_speed:
+            recent.clear()  # other bins: start again
+        elif recent and recent[-1][2] == sim.time:
+            recent.pop()  # the same moment again (paused): counted once
+        assert kT is not None
+        recent.append((self._upper_speed, histogram.density, sim.time, kT))
+        window = list(recent)[-self.histogram_window :]
+        density = np.mean([entry[1] for entry in window], axis=0)
+        law = MaxwellBoltzmann2D(float(np.mean([entry[3] for entry in window])), sim.particles.mass)
         return {
             "edges": histogram.bin_edges.tolist(),
-            "density": histogram.density.tolist(),
-            "maxwell_boltzmann": curve.tolist(),
+            "density": density.tolist(),
+            "maxwell_boltzmann": law.pdf(histogram.bin_centers).tolist(),
+            "readouts": len(window),
         }
+
+    def _piston(self) -> dict[str, float] | None:
+        """Where the piston is and how fast it moves, or None without one."""
+        piston = self.sim.piston()
+        if piston is None:
+            return None
+        return {"position": piston.position, "velocity": piston.velocity}
+
+    def _traced(self) -> dict[str, float] | None:
+        """The followed particle's speed (m/s), kinetic energy (J), mass, charge and radius."""
+        i = self.traced
+        if i is None or i >= self.sim.particles.n:
+            return None
+        p = self.sim.particles
+        mass = float(np.broadcast_to(p.mass, (p.n,))[i])
+        speed = float(np.hypot(*p.velocity[i]))
+        return {
+            "index": i, "speed": speed, "kinetic": 0.5 * mass * speed**2, "mass": mass,
+            "charge": float(np.broadcast_to(p.charge, (p.n,))[i]),
+            "radius": float(np.broadcast_to(p.radius, (p.n,))[i]),
+        }  # fmt: skip
 
     def frame(self, number: int) -> bytes:
         """The binary frame of the current state (velocities included with momentum on or
