@@ -319,3 +319,23 @@ def test_a_copy_continues_exactly_and_independently():
     assert twin.time == sim.time
     twin.particles.velocity *= 2
     assert not np.array_equal(twin.particles.velocity, sim.particles.velocity)
+
+
+def test_particles_added_and_removed_are_checked_and_keep_the_rest():
+    from collidium.errors import InputError as Refused
+
+    two = cd.Particles([[0.0, 0.0], [2.0, 0.0]], [[1.0, 0.0], [0.0, 0.0]])
+    sim = cd.Simulation(cd.Box(10.0, 10.0), two)
+    with pytest.raises(Refused, match="particles 1 and 2 overlap"):
+        sim.add_particles(cd.Particles([[2.1, 0.0]]))
+    with pytest.raises(Refused, match="position: particle 2"):
+        sim.add_particles(cd.Particles([[20.0, 0.0]]))
+    assert sim.particles.n == 2  # nothing changed
+    sim.add_particles(cd.Particles([[-3.0, 0.0]], [[0.0, 2.0]]))
+    assert sim.particles.n == 3 and sim.particles.radius.strides == (0,)  # still shared
+    sim.run(time=1.0)
+    sim.remove_particles([0])
+    assert sim.particles.n == 2
+    np.testing.assert_allclose(sim.particles.velocity[1], [0.0, 2.0])
+    with pytest.raises(Refused, match="indices: must be particles 0 to 1"):
+        sim.remove_particles([5])

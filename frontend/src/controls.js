@@ -132,6 +132,12 @@ export function createControls(container, { send, report, temperature }) {
   const momentumToggle = checkbox("toggle-momentum", "momentum vectors");
   const colourSelect = element("select", { id: "colour", title: "colour the disks by" });
 
+  // Pump: particles in through the hatch (the middle of the first wall) or out.
+  const pumpCount = element("input", { id: "pump-count", type: "number", step: "1", min: "1", max: "100", value: "10", inputmode: "numeric" });
+  const pumpTemperature = element("input", { id: "pump-temperature", type: "number", step: "any", min: "0", placeholder: "gas's", inputmode: "decimal" });
+  const pumpInButton = element("button", { id: "pump-in", type: "button", text: "Pump in", title: "let particles in through the hatch in the middle of the first wall" });
+  const pumpOutButton = element("button", { id: "pump-out", type: "button", text: "Let out", title: "let out the particles nearest the hatch" });
+
   // Files.
   const downloadButton = element("button", { id: "download", type: "button", text: "Download TOML" });
   const openInput = element("input", { id: "open-scenario", type: "file", accept: ".toml", className: "file-input" });
@@ -163,6 +169,12 @@ export function createControls(container, { send, report, temperature }) {
       momentumToggle.label,
       labelled("colour by", colourSelect),
       labelled("histogram", histogramSelect),
+    ]),
+    element("div", { className: "control-group pump-group" }, [
+      labelled("particles", pumpCount),
+      labelled("at kT (J)", pumpTemperature),
+      pumpInButton,
+      pumpOutButton,
     ]),
     element("div", { className: "control-group file-group" }, [downloadButton, openLabel]),
   );
@@ -273,6 +285,22 @@ export function createControls(container, { send, report, temperature }) {
     button.addEventListener("pointerdown", () => hold(kind));
     for (const name of ["pointerup", "pointerleave", "pointercancel"]) button.addEventListener(name, release);
   }
+  function pump(sign) {
+    const count = Number(pumpCount.value);
+    if (!Number.isInteger(count) || count < 1 || count > 100) {
+      report("count", `"${pumpCount.value}" is not a whole number from 1 to 100`);
+      return;
+    }
+    const text = pumpTemperature.value.trim();
+    const temperature = text === "" ? null : Number(text);
+    if (temperature !== null && !(temperature > 0)) {
+      report("temperature", `"${text}" is not a temperature > 0`);
+      return;
+    }
+    send({ type: "pump", count: sign * count, temperature });
+  }
+  pumpInButton.addEventListener("click", () => pump(1));
+  pumpOutButton.addEventListener("click", () => pump(-1));
   histogramSelect.addEventListener("change", () => send({ type: "histogram_window", readouts: Number(histogramSelect.value) }));
   colourSelect.addEventListener("change", () => send({ type: "colour", mode: colourSelect.value }));
   downloadButton.addEventListener("click", () => send({ type: "export" }));
@@ -318,7 +346,7 @@ export function createControls(container, { send, report, temperature }) {
       const held = typeof status.wall_temperature === "number";
       holdHeatButton.classList.toggle("held", held && holding);
       holdCoolButton.classList.toggle("held", held && holding);
-      for (const button of [holdHeatButton, holdCoolButton]) button.disabled = status.has_walls === false;
+      for (const button of [holdHeatButton, holdCoolButton, pumpInButton, pumpOutButton]) button.disabled = status.has_walls === false;
       if (typeof status.speed === "number" && status.speed > 0 && !sliderHeld) {
         speedSlider.value = String(sliderFromSpeed(status.speed, speedLimits));
         speedValue.textContent = speedLabel(status.speed);

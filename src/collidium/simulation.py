@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from collidium.collisions import COLLISION_MODES, CollisionMode, Tally, make_drift
 from collidium.errors import InputError, SimulationError
@@ -269,6 +270,46 @@ class Simulation:
     def forces(self, forces: Sequence[Coulomb]) -> None:
         _check_forces(forces, self.container)
         self._field = ForceField(tuple(forces))
+
+    def add_particles(self, new: Particles) -> None:
+        """Put ``new`` particles into the vessel, after the others (a pump, a source).
+
+        Raises
+        ------
+        InputError
+            If one lies outside the vessel (or beyond its piston) or overlaps another particle
+            (unless collisions are off), naming it; or if observers are attached, whose records
+            are per particle. Nothing changes then.
+        """
+        self._refuse_observers()
+        joined = self.particles.joined(new)
+        piston = self.piston()
+        _check_placement(
+            self.container, joined, self.collisions, None if piston is None else piston.position
+        )
+        self.particles = joined
+
+    def remove_particles(self, indices: ArrayLike) -> None:
+        """Take the particles at ``indices`` out of the vessel (a leak, a sink); the others keep
+        their order.
+
+        Raises
+        ------
+        InputError
+            If an index is not a particle's, or observers are attached.
+        """
+        self._refuse_observers()
+        chosen = np.asarray(indices, dtype=np.int64).reshape(-1)
+        if chosen.size and (chosen.min() < 0 or chosen.max() >= self.particles.n):
+            raise InputError("indices", f"must be particles 0 to {self.particles.n - 1}")
+        self.particles = self.particles.without(chosen)
+
+    def _refuse_observers(self) -> None:
+        if self.observers:
+            raise InputError(
+                "particles", "observers are attached; their records are per particle: "
+                "add or remove particles before attaching them"
+            )  # fmt: skip
 
     def run(
         self, time: float | None = None, steps: int | None = None, progress: bool = False
@@ -658,8 +699,10 @@ def overlap_detail(container: Vessel, particles: Particles, i: int, j: int) -> s
     return f"(centres {gap:g} m apart, radii {radius[i]:g} + {radius[j]:g})"
 
 
-def _check_placement(container: Vessel, particles: Particles, collisions: str) -> None:
-    outside = container.outside(particles.position, particles.radius)
+def _check_placement(
+    container: Vessel, particles: Particles, collisions: str, piston_at: float | None = None
+) -> None:
+    outside = container.outside(particles.position, particles.radius, piston_at)
     if outside.size:
         i = int(outside[0])
         detail = outside_detail(container, particles, i)

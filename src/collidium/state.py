@@ -144,6 +144,34 @@ class Particles:
         """A deep copy (arrays are copied; shared values stay shared)."""
         return Particles(*self.__reduce__()[1])
 
+    def joined(self, other: Particles) -> Particles:
+        """These particles followed by ``other``'s (a value both share stays shared)."""
+        properties: list[float | FloatArray] = []
+        for name in PROPERTIES:
+            mine, theirs = as_given(getattr(self, name)), as_given(getattr(other, name))
+            same = isinstance(mine, float) and isinstance(theirs, float) and mine == theirs
+            properties.append(
+                mine if same else np.concatenate([getattr(self, name), getattr(other, name)])
+            )
+        mass, radius, charge = properties
+        return Particles(
+            np.concatenate([self.position, other.position]),
+            np.concatenate([self.velocity, other.velocity]),
+            mass, radius, charge, np.concatenate([self.image, other.image]),
+        )  # fmt: skip
+
+    def without(self, indices: ArrayLike) -> Particles:
+        """These particles less those at ``indices`` (the rest keep their order)."""
+        keep = np.ones(self.n, dtype=bool)
+        keep[np.asarray(indices, dtype=np.int64)] = False
+        given = (as_given(getattr(self, name)) for name in PROPERTIES)
+        mass, radius, charge = (
+            value if isinstance(value, float) else value[keep] for value in given
+        )
+        return Particles(
+            self.position[keep], self.velocity[keep], mass, radius, charge, self.image[keep]
+        )
+
     def __deepcopy__(self, memo: dict[int, object]) -> Particles:
         return self.copy()
 

@@ -377,12 +377,13 @@ def test_charges_are_coloured_and_marked_with_their_sign(page):
     hits = []
     for i, (column, row, radius) in enumerate(disk_centres(page, "#overlay", range(40))):
         body = image[row + round(0.45 * radius), column + round(0.45 * radius)]
-        colour = [0xD6, 0x27, 0x28] if charges[i] > 0 else [0x1F, 0x77, 0xB4]
+        red = body[0] > 2 * body[2]  # red (0xd6, 0x27, 0x28), shaded or not, against blue
+        blue = body[2] > 2 * body[0]  # (0x1f, 0x77, 0xb4)
         # A 1.5 px bar falls on the pixels around its line: the whitest of three is on it.
         centre = whiteness[row - 1 : row + 2, column - 1 : column + 2].max()
         above = whiteness[row - round(0.45 * radius), column - 1 : column + 2].max()
         hits.append(
-            np.abs(body - colour).max() <= 20
+            (red if charges[i] > 0 else blue)
             and centre > 200  # the bar of both signs crosses the centre
             and (above > 150) == (charges[i] > 0)  # only + has an upright bar
         )
@@ -480,3 +481,19 @@ def test_every_preset_opens_with_its_explanation_and_is_saved_as_a_screenshot(pa
         target = artifacts / f"viewer-{name}.png"
         page.screenshot(path=str(target))
         assert target.stat().st_size > 10_000
+
+
+def test_the_pump_lets_particles_in_and_out(page):
+    page.wait_for_function(
+        "window.collidiumViewer.stats && window.collidiumViewer.stats.temperature > 0"
+    )
+    page.fill("#pump-count", "10")
+    page.click("#pump-in")
+    page.wait_for_function("window.collidiumViewer.scene.n > 200")
+    grown = page.evaluate("window.collidiumViewer.scene.n")
+    page.wait_for_function(f"document.querySelector('#readout-n').dataset.value === '{grown}'")
+    page.click("#pump-out")
+    page.wait_for_function(f"window.collidiumViewer.scene.n === {grown - 10}")
+    page.fill("#pump-count", "0")
+    page.click("#pump-in")
+    assert page.inner_text("#message").startswith('count: "0" is not a whole number')

@@ -356,3 +356,39 @@ def test_the_followed_disk_is_described(gas):
     assert traced["kinetic"] == pytest.approx(0.5 * speed**2, rel=1e-15)  # m = 1 kg
     gas.trace(None)
     assert gas.stats()["traced"] is None
+
+
+def test_a_pump_lets_thermal_particles_in_at_the_hatch_and_out_again(gas):
+    before = gas.sim.particles.n
+    added = gas.pump(30, kT=4.0)
+    p = gas.sim.particles
+    assert 0 < added <= 30 and p.n == before + added
+    new = slice(before, None)
+    # In at the middle of the first wall (the bottom of the box), moving up into it.
+    assert np.all(np.abs(p.position[new, 1] + 10.0) < 0.3) and np.all(p.velocity[new, 1] > 0)
+    gas.sim.run(steps=200)
+    assert gas.sim.escaped() == 0 and gas.scene()["n"] == p.n
+    let_out = gas.pump(-40)
+    assert let_out == 40 and gas.sim.particles.n == p.n - 40
+
+
+def test_pumped_speeds_are_those_a_thermal_wall_emits(gas):
+    """Normal speeds Rayleigh, tangential Gaussian, at sigma = sqrt(kT / m): KS tests."""
+    from scipy import stats
+
+    normal, tangential = [], []
+    for seed in range(20):
+        session = ViewerSession(preset("gas", n=20, seed=seed), preset="gas")
+        start = session.sim.particles.n
+        session.pump(100, kT=9.0)
+        velocity = session.sim.particles.velocity[start:]
+        normal += list(velocity[:, 1])
+        tangential += list(velocity[:, 0])
+    assert stats.kstest(normal, stats.rayleigh(scale=3.0).cdf).pvalue > 1e-3
+    assert stats.kstest(tangential, stats.norm(scale=3.0).cdf).pvalue > 1e-3
+
+
+def test_a_periodic_box_has_no_hatch():
+    periodic = ViewerSession(preset("granular", n=50), preset="granular")
+    with pytest.raises(InputError, match="pump: a periodic box has no wall to pump through"):
+        periodic.pump(5)

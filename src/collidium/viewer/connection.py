@@ -180,6 +180,9 @@ class Connection:
                 s.set_colour(mode)
             case protocol.WallTemperature(temperature=kT):
                 s.hold_wall_temperature(kT)
+            case protocol.Pump(count=count, temperature=kT):
+                s.pump(count, kT)
+                return [s.scene(), s.status(), self._stats()]
             case protocol.HistogramWindow(readouts=readouts):
                 s.set_histogram_window(readouts)
             case protocol.Reset():

@@ -14,6 +14,8 @@ Front end to server (validated by `parse_message`; a bad one gets an ``error`` r
     colour         mode: str                 colour the disks by "speed", "charge" or "species"
     wall_temperature  temperature: float | null  hold the walls at kT (J) (heat or cool
                                              continuously); null gives them back
+    pump           count: int, temperature   let particles in through the hatch at kT (J; null:
+                                             the gas's), or out (count < 0)
     histogram_window  readouts: int          average the speed histogram over the last readouts
     trace          index: int | null         follow a particle's path (null: none)
     set_velocity   index: int, vx, vy        m/s
@@ -68,6 +70,8 @@ SPEED_RANGE = (0.01, 100.0)
 HEAT_RANGE = (0.1, 10.0)
 #: Hottest a wall may be held, kT in J.
 MAX_WALL_TEMPERATURE = 1e12
+#: Most particles one pump message lets in or out.
+MAX_PUMPED = 100
 #: Most readouts the speed histogram may be averaged over.
 MAX_HISTOGRAM_WINDOW = 50
 #: Fastest speed a particle may be given by dragging, m/s.
@@ -137,6 +141,14 @@ class WallTemperature(_Message):
     temperature: Annotated[float, Field(gt=0, le=MAX_WALL_TEMPERATURE, allow_inf_nan=False)] | None
 
 
+class Pump(_Message):
+    type: Literal["pump"]
+    count: Annotated[int, Field(ge=-MAX_PUMPED, le=MAX_PUMPED)]
+    temperature: (
+        Annotated[float, Field(gt=0, le=MAX_WALL_TEMPERATURE, allow_inf_nan=False)] | None
+    ) = None
+
+
 class HistogramWindow(_Message):
     type: Literal["histogram_window"]
     readouts: Annotated[int, Field(ge=1, le=MAX_HISTOGRAM_WINDOW)]
@@ -174,7 +186,7 @@ class Raw(_Message):
 
 Message = Annotated[
     Ready | Ack | Play | Pause | Step | Reset | Export | Speed | Heat | Toggle | Colour
-    | WallTemperature | HistogramWindow | Trace
+    | WallTemperature | Pump | HistogramWindow | Trace
     | SetVelocity | Load | ScenarioText | Raw,
     Field(discriminator="type"),
 ]  # fmt: skip
@@ -182,7 +194,8 @@ _MESSAGE: TypeAdapter[Message] = TypeAdapter(Message)
 #: The ``type`` of each message the front end may send.
 MESSAGE_TYPES = (
     "ready", "ack", "play", "pause", "step", "reset", "export", "speed", "heat", "collisions",
-    "charges", "momentum", "colour", "wall_temperature", "histogram_window", "trace",
+    "charges", "momentum", "colour", "wall_temperature", "pump", "histogram_window",
+    "trace",
     "set_velocity", "load", "scenario", "raw",
 )  # fmt: skip
 

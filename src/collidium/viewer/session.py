@@ -193,6 +193,31 @@ class ViewerSession:
             self.sim.container = vessel.with_walls({name: Thermal(kT) for name in walls})
         self.wall_temperature = kT
 
+    def pump(self, count: int, kT: float | None = None) -> int:
+        """Let ``count`` particles in through the hatch (the middle of the vessel's first wall)
+        at temperature ``kT`` (J; default the gas's), or, with ``count`` < 0, let out the
+        ``-count`` nearest the hatch. A particle let in is a copy of particle 0 (mass, radius,
+        charge) with a velocity drawn as a thermal wall emits (`collidium.vessels.walls.Thermal`):
+        those that would overlap another wait for a later pump. Returns how many went in or out.
+        """
+        hatch, inward = _hatch(self._vessel)
+        p = self.sim.particles
+        if count < 0:
+            nearest = np.argsort(np.hypot(*(p.position - hatch).T))[: min(-count, p.n)]
+            self.sim.remove_particles(nearest)
+        else:
+            count = min(count, protocol.MAX_PARTICLES - p.n)
+            kT = kT if kT is not None else (self.sim.temperature() if p.n else 0.0)
+            if p.n == 0 or not kT > 0:
+                raise InputError("temperature", "give the temperature of the gas to let in")
+            added = _arrivals(p, self.sim.rng, count, kT, hatch, inward)
+            blocked = _blocked(added, p) | _outside(self.sim, added)
+            added = added.without(np.flatnonzero(blocked))
+            self.sim.add_particles(added)
+            count = added.n
+        self._changed()
+        return abs(count)
+
     def set_histogram_window(self, readouts: int) -> None:
         """Average the speed histogram over the last ``readouts`` stats messages (1: none)."""
         self.histogram_window = readouts
@@ -507,6 +532,56 @@ def _species(particles: Particles) -> tuple[np.ndarray, list[str]]:
         for kind in kinds
     ]
     return index.reshape(-1), labels
+
+
+def _hatch(vessel: Any) -> tuple[FloatArray, FloatArray]:
+    """The middle of the vessel's first wall and the unit normal into the vessel there."""
+    outline = vessel.outline()
+    if vessel.periodic or outline.shape[0] < 3:
+        raise InputError("pump", "a periodic box has no wall to pump through")
+    start, end = outline[0], outline[1]
+    along = (end - start) / np.hypot(*(end - start))
+    return 0.5 * (start + end), np.array([-along[1], along[0]])  # the outline turns left
+
+
+def _arrivals(
+    like: Particles,
+    rng: np.random.Generator,
+    count: int,
+    kT: float,
+    hatch: FloatArray,
+    inward: FloatArray,
+) -> Particles:
+    """``count`` copies of particle 0 of ``like`` in a row along the wall at ``hatch``, one
+    radius and a little inside, moving in as a thermal wall at ``kT`` emits them (normal speed
+    Rayleigh-distributed, tangential Gaussian)."""
+    mass, radius, charge = (float(np.broadcast_to(getattr(like, name), (like.n,))[0])
+                            for name in ("mass", "radius", "charge"))  # fmt: skip
+    spacing = 2.0 * radius * 1.05 + 1e-6
+    offsets = (np.arange(count) - 0.5 * (count - 1)) * spacing
+    along = np.array([inward[1], -inward[0]])
+    position = hatch + np.outer(offsets, along) + inward * (radius * 1.05 + 1e-6)
+    sigma = math.sqrt(kT / mass)
+    normal = sigma * np.sqrt(-2.0 * np.log1p(-rng.random(count)))
+    tangential = sigma * rng.standard_normal(count)
+    velocity = np.outer(normal, inward) + np.outer(tangential, along)
+    return Particles(position, velocity, mass, radius, charge)
+
+
+def _blocked(added: Particles, present: Particles) -> np.ndarray:
+    """Which of ``added`` (a few) would overlap one of ``present``: O(added x present)."""
+    gaps = np.hypot(*(added.position[:, None, :] - present.position[None, :, :]).transpose(2, 0, 1))
+    return (gaps < added.radius[:, None] + present.radius[None, :]).any(axis=1)
+
+
+def _outside(sim: Simulation, added: Particles) -> np.ndarray:
+    """Which of ``added`` lie outside the vessel (or beyond its piston)."""
+    piston = sim.piston()
+    where = sim.container.outside(added.position, added.radius,
+                                  None if piston is None else piston.position)  # fmt: skip
+    out = np.zeros(added.n, dtype=bool)
+    out[where] = True
+    return out
 
 
 def _compact(values: FloatArray) -> float | list[float]:
