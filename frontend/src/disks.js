@@ -137,14 +137,6 @@ function chargeColour(charge) {
   return NEUTRAL;
 }
 
-/** The colour (0-255 rgb) of `fraction` of the way along the speed colormap (clamped). */
-export function speedColour(fraction) {
-  const at = Math.min(1, Math.max(0, Number.isFinite(fraction) ? fraction : 0)) * (SPEED_STOPS.length - 1);
-  const low = Math.min(Math.floor(at), SPEED_STOPS.length - 2);
-  const t = at - low;
-  return SPEED_STOPS[low].map((value, c) => value + t * (SPEED_STOPS[low + 1][c] - value));
-}
-
 /** Writes colour `rgb` (0-255) of particle `i` into the interleaved rgb + radius `styles`. */
 function setColour(styles, i, rgb) {
   for (let c = 0; c < 3; c += 1) styles[4 * i + c] = rgb[c] / 255;

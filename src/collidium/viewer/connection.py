@@ -95,7 +95,7 @@ class Connection:
         if self._credit == 0 and now - self._last_ack > STALL_SECONDS:
             return []  # nobody is watching: wait
         out: list[Outgoing] = []
-        starting = self.session.status()["phase"] == "starting"
+        starting = self.session.starting
         try:
             self.session.advance(elapsed, self.budget)
         except SimulationError as exc:
@@ -107,7 +107,7 @@ class Connection:
                     self.session.status()]  # fmt: skip
         if self._credit > 0 and self.session.version != self._framed:
             out.append(self._frame())
-        if starting and self.session.status()["phase"] == "running":
+        if starting and not self.session.starting:
             out.append(self.session.status())  # the page stops saying "starting"
         if now - self._last_stats >= STATS_PERIOD and self.session.version != self._reported:
             out.append(self._stats())

@@ -23,8 +23,9 @@ from collidium.observers.thermo import Thermo
 from collidium.presets import PRESETS, describe_presets, preset
 from collidium.scenario import Scenario
 from collidium.simulation import Simulation
-from collidium.state import FloatArray, Particles, uniform_or_each
+from collidium.state import PROPERTIES, FloatArray, Particles, uniform_or_each
 from collidium.theory import MaxwellBoltzmann2D
+from collidium.vessels import Vessel
 from collidium.vessels.walls import Thermal
 from collidium.viewer import protocol
 from collidium.viewer.builder import BUILDER
@@ -248,6 +249,12 @@ class ViewerSession:
         self._changed()
 
     @property
+    def starting(self) -> bool:
+        """True until the first step has run (on a fresh installation it compiles the
+        kernels)."""
+        return not self._loaded
+
+    @property
     def collisions_enabled(self) -> bool:
         """Whether disks collide with each other."""
         return self.sim.collisions != "off"
@@ -389,7 +396,7 @@ class ViewerSession:
             "momentum": self.momentum, "colour": self.colour,
             "wall_temperature": self.wall_temperature, "histogram_window": self.histogram_window,
             "has_walls": bool(self._vessel.shape_walls),
-            "phase": "running" if self._loaded else "starting",
+            "phase": "starting" if self.starting else "running",
         }  # fmt: skip
 
     def stats(self) -> dict[str, Any]:
@@ -482,12 +489,12 @@ class ViewerSession:
         if i is None or i >= self.sim.particles.n:
             return None
         p = self.sim.particles
-        mass = float(np.broadcast_to(p.mass, (p.n,))[i])
+        mass = float(p.mass[i])
         speed = float(np.hypot(*p.velocity[i]))
         return {
             "index": i, "speed": speed, "kinetic": 0.5 * mass * speed**2, "mass": mass,
-            "charge": float(np.broadcast_to(p.charge, (p.n,))[i]),
-            "radius": float(np.broadcast_to(p.radius, (p.n,))[i]),
+            "charge": float(p.charge[i]),
+            "radius": float(p.radius[i]),
         }  # fmt: skip
 
     def frame(self, number: int) -> bytes:
@@ -522,9 +529,7 @@ def _species(particles: Particles) -> tuple[np.ndarray, list[str]]:
     if particles.n == 0:
         return np.zeros(0, dtype=np.int64), []
     fields = (("mass", "kg"), ("radius", "m"), ("charge", "C"))
-    table = np.column_stack(
-        [np.broadcast_to(getattr(particles, f), (particles.n,)) for f, _ in fields]
-    )
+    table = np.column_stack([getattr(particles, f) for f, _ in fields])
     kinds, index = np.unique(table, axis=0, return_inverse=True)
     differing = [j for j in range(len(fields)) if np.unique(kinds[:, j]).size > 1]
     labels = [
@@ -534,7 +539,7 @@ def _species(particles: Particles) -> tuple[np.ndarray, list[str]]:
     return index.reshape(-1), labels
 
 
-def _hatch(vessel: Any) -> tuple[FloatArray, FloatArray]:
+def _hatch(vessel: Vessel) -> tuple[FloatArray, FloatArray]:
     """The middle of the vessel's first wall and the unit normal into the vessel there."""
     outline = vessel.outline()
     if vessel.periodic or outline.shape[0] < 3:
@@ -555,8 +560,7 @@ def _arrivals(
     """``count`` copies of particle 0 of ``like`` in a row along the wall at ``hatch``, one
     radius and a little inside, moving in as a thermal wall at ``kT`` emits them (normal speed
     Rayleigh-distributed, tangential Gaussian)."""
-    mass, radius, charge = (float(np.broadcast_to(getattr(like, name), (like.n,))[0])
-                            for name in ("mass", "radius", "charge"))  # fmt: skip
+    mass, radius, charge = (float(getattr(like, name)[0]) for name in PROPERTIES)
     spacing = 2.0 * radius * 1.05 + 1e-6
     offsets = (np.arange(count) - 0.5 * (count - 1)) * spacing
     along = np.array([inward[1], -inward[0]])
