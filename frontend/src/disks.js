@@ -25,6 +25,12 @@ const RIM_CSS_PX = 1;
 /** The median momentum vector is drawn this many typical disk diameters long. */
 const MOMENTUM_DIAMETERS = 2;
 const MOMENTUM_SAMPLE = 511;
+/** A momentum arrow's head: its barbs' length (a third of the arrow, at most this many CSS
+ * pixels) and their angle to the shaft. */
+const ARROW_HEAD_CSS_PX = 7;
+const ARROW_HEAD_ANGLE = 0.45;
+/** Vertices per momentum arrow (gl.LINES): the shaft and two barbs. */
+const ARROW_VERTICES = 6;
 
 /** Quads and point sprites reach this many device pixels past the disk's edge, so the
  * anti-aliased edge pixels are always covered and both drawing paths shade the same pixels. */
@@ -181,7 +187,7 @@ function createContext(canvas) {
   try {
     return createREGL({
       canvas,
-      attributes: { antialias: true, premultipliedAlpha: true },
+      attributes: { antialias: true, premultipliedAlpha: true, stencil: true },
       optionalExtensions: ["ANGLE_instanced_arrays"],
       onDone: (error) => error && warn(error), // regl's default onDone throws
     });
@@ -370,6 +376,28 @@ export function createDiskRenderer(canvas, viewport) {
     depth: { enable: false },
   });
 
+  const stencilled = (stencil, colorMask = [true, true, true, true]) => regl({
+    vert: FLAT_VERT,
+    frag: FLAT_FRAG,
+    primitive: regl.prop("primitive"),
+    attributes: { position: regl.prop("positions") },
+    uniforms: { scale: regl.prop("scale"), stretch: regl.prop("stretch"), colour: regl.prop("colour") },
+    count: regl.prop("count"),
+    blend,
+    depth: { enable: false },
+    stencil,
+    colorMask,
+  });
+  // The vessel's triangles set the stencil to 1 (nothing drawn); then lines drawn only there.
+  const markVesselStencil = stencilled({
+    enable: true,
+    mask: 0xff,
+    func: { cmp: "always", ref: 1, mask: 0xff },
+    op: { fail: "replace", zfail: "replace", zpass: "replace" },
+  }, [false, false, false, false]);
+  const markVessel = (props) => markVesselStencil({ ...props, primitive: "triangles", colour: [0, 0, 0, 0] });
+  const drawInVessel = stencilled({ enable: true, mask: 0, func: { cmp: "equal", ref: 1, mask: 0xff } });
+
   let periodic = false;
 
   /** Fills a static buffer with points nested `depth` levels in arrays ([x, y] at depth 1,
@@ -422,8 +450,8 @@ export function createDiskRenderer(canvas, viewport) {
     capacity = n;
     const slots = Math.max(1, n);
     positionBuffer({ usage: "dynamic", type: "float", length: 8 * slots });
-    lineBuffer({ usage: "dynamic", type: "float", length: 16 * slots });
-    lineData = new Float32Array(4 * slots);
+    lineBuffer({ usage: "dynamic", type: "float", length: 8 * ARROW_VERTICES * slots });
+    lineData = new Float32Array(2 * ARROW_VERTICES * slots);
     momenta = new Float32Array(slots);
   }
 
@@ -442,7 +470,8 @@ export function createDiskRenderer(canvas, viewport) {
     }
   }
 
-  /** Segments centre -> centre + s * m v, with s making the median |m v| a couple of diameters. */
+  /** Arrows centre -> centre + s * m v, with s making the median |m v| a couple of diameters:
+   * a shaft and two barbs each (gl.LINES). */
   function buildMomentumLines(positions, velocities, n) {
     for (let i = 0; i < n; i += 1) {
       momenta[i] = masses[i] * Math.hypot(velocities[2 * i], velocities[2 * i + 1]);
@@ -450,23 +479,30 @@ export function createDiskRenderer(canvas, viewport) {
     const median = sampledMedian(momenta.subarray(0, n), medianScratch);
     const diameter = typicalRadius > 0 ? 2 * typicalRadius : DOT_CSS_PX / viewport.pixelsPerMetre;
     const scale = median > 0 ? (MOMENTUM_DIAMETERS * diameter) / median : 0;
+    const longestBarb = ARROW_HEAD_CSS_PX / viewport.pixelsPerMetre;
+    const [cos, sin] = [Math.cos(ARROW_HEAD_ANGLE), Math.sin(ARROW_HEAD_ANGLE)];
     for (let i = 0; i < n; i += 1) {
       const x = positions[2 * i];
       const y = positions[2 * i + 1];
-      const k = scale * masses[i];
-      lineData[4 * i] = x;
-      lineData[4 * i + 1] = y;
-      lineData[4 * i + 2] = x + k * velocities[2 * i];
-      lineData[4 * i + 3] = y + k * velocities[2 * i + 1];
+      const dx = scale * masses[i] * velocities[2 * i];
+      const dy = scale * masses[i] * velocities[2 * i + 1];
+      // A barb is the shaft turned back by +-ARROW_HEAD_ANGLE, shortened to `barb`.
+      const length = Math.hypot(dx, dy);
+      const barb = length > 0 ? Math.min(length / 3, longestBarb) / length : 0;
+      const [bx, by] = [-barb * dx, -barb * dy];
+      const [tipX, tipY] = [x + dx, y + dy];
+      lineData.set([x, y, tipX, tipY,
+        tipX, tipY, tipX + cos * bx - sin * by, tipY + sin * bx + cos * by,
+        tipX, tipY, tipX + cos * bx + sin * by, tipY - sin * bx + cos * by], 2 * ARROW_VERTICES * i);
     }
-    lineBuffer.subdata(lineData.subarray(0, 4 * n));
-    return 2 * n;
+    lineBuffer.subdata(lineData.subarray(0, 2 * ARROW_VERTICES * n));
+    return ARROW_VERTICES * n;
   }
 
   /** Redraws everything with the current buffers and viewport (call after a frame or resize). */
   function draw() {
     regl.poll(); // picks up canvas size changes for the viewport
-    regl.clear({ color: LETTERBOX });
+    regl.clear({ color: LETTERBOX, stencil: 0 });
     const scale = viewport.clipScale();
     const stretch = [1, 1];
     const dpr = viewport.pixelRatio;
@@ -498,7 +534,11 @@ export function createDiskRenderer(canvas, viewport) {
       });
     }
     if (lineVertices > 0) {
-      drawFlat({ primitive: "lines", positions: lineBuffer, count: lineVertices, scale, stretch: [1, 1], colour: [0.13, 0.13, 0.13, 0.85] });
+      // Clipped to the vessel: its fill marks the stencil, the arrows are drawn where it is set.
+      const clipped = fillVertices > 2;
+      if (clipped) markVessel({ positions: vesselFill, count: fillVertices, scale, stretch });
+      const arrows = { primitive: "lines", positions: lineBuffer, count: lineVertices, scale, stretch };
+      (clipped ? drawInVessel : drawFlat)({ ...arrows, colour: [0.13, 0.13, 0.13, 0.85] });
     }
   }
 

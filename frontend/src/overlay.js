@@ -1,5 +1,6 @@
 // The 2D canvas above the WebGL one: the traced particle's path and marker, and the arrow shown
-// while dragging a particle to give it a new velocity. Cheap to redraw, so it is redrawn whole.
+// while dragging a particle to give it a new velocity, charge marks, the highlighted disk and the
+// grip on a wall that can be dragged. Cheap to redraw, so it is redrawn whole.
 
 const TRACE_COLOUR = "#ff7f0e";
 const HIGHLIGHT_COLOUR = "#e6a700";
@@ -8,6 +9,10 @@ const MARK_MIN_RADIUS_PX = 5;
 const MARK_MOST_DISKS = 5000;
 const DRAG_COLOUR = "#2b2b2b";
 const ARROW_HEAD_PX = 9;
+const GRIP_COLOUR = "#8a5a2b";
+/** The grip on a movable wall: its length and thickness, CSS pixels. */
+const GRIP_LENGTH_PX = 30;
+const GRIP_WIDTH_PX = 7;
 
 export function createOverlay(canvas, viewport) {
   const context = canvas.getContext("2d");
@@ -15,10 +20,11 @@ export function createOverlay(canvas, viewport) {
   /**
    * Draws the + and - `marks` = {positions, charges, radii, n} on charged disks, the highlighted
    * disk `highlight` = {x, y, radius, label}, `trace` (a trace path) with a ring around
-   * `tracedAt` = {x, y, radius}, and the drag arrow `drag` = {from: [x, y], to: [x, y]} in metres,
-   * each when given.
+   * `tracedAt` = {x, y, radius}, the drag arrow `drag` = {from: [x, y], to: [x, y]} in metres,
+   * and a grip on the middle of the movable wall's face `grip` = [[x0, y0], [x1, y1]] m, each
+   * when given.
    */
-  function draw({ marks, highlight, trace, tracedAt, drag }) {
+  function draw({ marks, highlight, trace, tracedAt, drag, grip }) {
     const dpr = viewport.pixelRatio;
     context.setTransform(dpr, 0, 0, dpr, 0, 0);
     context.clearRect(0, 0, viewport.cssWidth, viewport.cssHeight);
@@ -27,6 +33,30 @@ export function createOverlay(canvas, viewport) {
     if (trace && trace.length > 1) drawPath(trace);
     if (tracedAt) drawMarker(tracedAt);
     if (drag) drawArrow(drag.from, drag.to);
+    if (grip) drawGrip(grip);
+  }
+
+  /** A bar along the face's middle, with ridges across it: "this can be dragged". */
+  function drawGrip([[x0, y0], [x1, y1]]) {
+    const [a, b] = [viewport.worldToCss(x0, y0), viewport.worldToCss(x1, y1)];
+    const [cx, cy] = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2];
+    const vertical = Math.abs(b[1] - a[1]) > Math.abs(b[0] - a[0]);
+    const [w, h] = vertical ? [GRIP_WIDTH_PX, GRIP_LENGTH_PX] : [GRIP_LENGTH_PX, GRIP_WIDTH_PX];
+    context.fillStyle = GRIP_COLOUR;
+    context.fillRect(cx - w / 2, cy - h / 2, w, h);
+    context.strokeStyle = "#fff";
+    context.lineWidth = 1;
+    context.beginPath();
+    for (const offset of [-6, 0, 6]) {
+      if (vertical) {
+        context.moveTo(cx - w / 2 + 1, cy + offset);
+        context.lineTo(cx + w / 2 - 1, cy + offset);
+      } else {
+        context.moveTo(cx + offset, cy - h / 2 + 1);
+        context.lineTo(cx + offset, cy + h / 2 - 1);
+      }
+    }
+    context.stroke();
   }
 
   /** A white + or - across each charged disk large enough to carry one. */

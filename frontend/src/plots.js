@@ -1,5 +1,6 @@
-// The two uPlot charts: energies and total speed against time (a rolling window), and the speed
-// histogram with the Maxwell-Boltzmann density. Each fills its container and follows its size.
+// The uPlot charts: energies and, on a small panel of its own, total speed against time (a
+// rolling window), and the speed histogram with the Maxwell-Boltzmann density. Each fills its
+// container and follows its size.
 import uPlot from "uplot";
 
 export const MAX_ENERGY_POINTS = 2000;
@@ -51,26 +52,23 @@ function mountPlot(container, options, data) {
   };
 }
 
-/** Energies (left axis) and total speed (right axis) against simulated time. */
-export function createEnergyPlot(container) {
-  const columns = [[], [], [], [], []]; // time, kinetic, potential, total, total speed
+/**
+ * Lines against simulated time in a rolling window: `series` = [{label, stroke}], their values
+ * read from each stats message by `read(stats)` (an array, one per series), on the axis `label`.
+ * A `compact` plot has no legend and no time label (a small panel under another).
+ */
+function createTimePlot(container, label, series, read, compact = false) {
+  const columns = [[], ...series.map(() => [])];
   const { plot, destroy } = mountPlot(
     container,
     {
-      scales: { x: { time: false }, energy: {}, speed: {} },
+      scales: { x: { time: false }, y: {} },
       axes: [
-        { label: "time (s)", values: tickValues, labelSize: 18 },
-        valueAxis("energy (J)", "energy"),
-        valueAxis("total speed (m/s)", "speed", { side: 1, grid: { show: false } }),
+        compact ? { values: tickValues, size: 24 } : { label: "time (s)", values: tickValues, labelSize: 18 },
+        valueAxis(label, "y"),
       ],
-      series: [
-        { label: "time (s)" },
-        { label: "kinetic", stroke: KINETIC, scale: "energy", width: 1.5 },
-        { label: "potential", stroke: POTENTIAL, scale: "energy", width: 1.5 },
-        { label: "total", stroke: TOTAL, scale: "energy", width: 1.5 },
-        { label: "total speed", stroke: SPEED, scale: "speed", width: 1.5 },
-      ],
-      legend: { live: false },
+      series: [{ label: "time (s)" }, ...series.map((line) => ({ ...line, scale: "y", width: 1.5 }))],
+      legend: { live: false, show: !compact },
       cursor: { drag: { x: false, y: false } },
     },
     columns,
@@ -82,8 +80,7 @@ export function createEnergyPlot(container) {
     },
     /** Appends one stats message's values, dropping the oldest beyond MAX_ENERGY_POINTS. */
     append(stats) {
-      const energy = stats.energy ?? {};
-      const row = [stats.time, energy.kinetic, energy.potential, energy.total, stats.total_speed];
+      const row = [stats.time, ...read(stats)];
       row.forEach((value, i) => columns[i].push(typeof value === "number" ? value : null));
       const excess = columns[0].length - MAX_ENERGY_POINTS;
       if (excess > 0) columns.forEach((column) => column.splice(0, excess));
@@ -95,6 +92,45 @@ export function createEnergyPlot(container) {
     },
     destroy,
   };
+}
+
+/** Kinetic, potential and total energy against simulated time; without forces the total alone
+ * (the kinetic energy would lie under it, and the potential at 0 says nothing). */
+export function createEnergyPlot(container) {
+  const names = (forces) => (forces ? ["kinetic", "potential", "total"] : ["total"]);
+  const colours = { kinetic: KINETIC, potential: POTENTIAL, total: TOTAL };
+  let forces = false;
+  let lines = null;
+  function mount() {
+    const shown = names(forces);
+    const read = (stats) => shown.map((name) => stats.energy?.[name]);
+    lines = createTimePlot(container, "energy (J)", shown.map((label) => ({ label, stroke: colours[label] })), read);
+  }
+  mount();
+  return {
+    get points() {
+      return lines.points;
+    },
+    get shown() {
+      return names(forces);
+    },
+    /** Whether the scene has forces (the plot is rebuilt with its lines when that changes). */
+    setForces(value) {
+      if (Boolean(value) === forces) return;
+      forces = Boolean(value);
+      lines.destroy();
+      mount();
+    },
+    append: (stats) => lines.append(stats),
+    clear: () => lines.clear(),
+    destroy: () => lines.destroy(),
+  };
+}
+
+/** The seed's "total speed", the sum of the speeds, on a panel of its own (it is the noisiest
+ * line, and not an energy). */
+export function createTotalSpeedPlot(container) {
+  return createTimePlot(container, "Σ|v| (m/s)", [{ label: "total speed", stroke: SPEED }], (stats) => [stats.total_speed], true);
 }
 
 /** Measured speed density as bars, with the Maxwell-Boltzmann density as a line. */

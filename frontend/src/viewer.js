@@ -10,10 +10,11 @@ import { createMessageBar } from "./message.js";
 import { createOverlay } from "./overlay.js";
 import { createInstruments } from "./instruments.js";
 import { createLegend } from "./legend.js";
-import { createEnergyPlot, createSpeedPlot } from "./plots.js";
+import { createEnergyPlot, createSpeedPlot, createTotalSpeedPlot } from "./plots.js";
 import { attachPointer } from "./pointer.js";
 import { createReadouts } from "./readouts.js";
 import { createTracePath } from "./trace.js";
+import { createMovableWall, WALL } from "./wall.js";
 
 /** Extra reach, in CSS pixels, around a disk when clicking on it. */
 const PICK_SLACK_PX = 3;
@@ -29,6 +30,7 @@ function buildLayout(root) {
   const overlay = element("canvas", { id: "overlay" });
   const vessel = element("div", { id: "vessel" }, [particles, overlay]);
   const energy = element("div", { id: "energy-plot", className: "plot" });
+  const totalSpeed = element("div", { id: "total-speed-plot", className: "plot small-plot" });
   const speed = element("div", { id: "speed-plot", className: "plot" });
   const readouts = element("div", { className: "collidium-readouts" });
   const instruments = element("div", { id: "instruments", className: "collidium-instruments" });
@@ -38,13 +40,13 @@ function buildLayout(root) {
   root.classList.add("collidium");
   root.replaceChildren(
     vessel,
-    element("div", { className: "collidium-plots" }, [instruments, energy, speed]),
+    element("div", { className: "collidium-plots" }, [instruments, energy, totalSpeed, speed]),
     readouts,
     explanation,
     controls,
     message,
   );
-  return { vessel, particles, overlay, energy, speed, readouts, instruments, explanation, controls, message };
+  return { vessel, particles, overlay, energy, totalSpeed, speed, readouts, instruments, explanation, controls, message };
 }
 
 function describeScene(scene) {
@@ -60,12 +62,14 @@ export function mountViewer(root, transport) {
   if (renderer === NO_RENDERER) messageBar.lasting(NO_WEBGL);
   const overlay = createOverlay(layout.overlay, viewport);
   const energyPlot = createEnergyPlot(layout.energy);
+  const totalSpeedPlot = createTotalSpeedPlot(layout.totalSpeed);
   const speedPlot = createSpeedPlot(layout.speed);
   const readouts = createReadouts(layout.readouts);
   const legend = createLegend(layout.vessel);
   const instruments = createInstruments(layout.instruments);
   const trace = createTracePath();
   const send = (message) => transport.send(message);
+  const movableWall = createMovableWall(viewport, send);
   const report = (field, reason) => messageBar.error(field ? `${field}: ${reason}` : reason);
   const temperature = () => state.stats?.temperature ?? null;
   const controls = createControls(layout.controls, { send, report, temperature });
@@ -87,6 +91,7 @@ export function mountViewer(root, transport) {
     drawnFrame: null, // the frame on screen (used for picking and dragging)
     pendingAcks: [],
     drag: null, // {index, pointer: [x, y] in metres}
+    draggingWall: false,
     needsRedraw: false,
     overlayDirty: false,
     rafId: 0,
@@ -140,7 +145,8 @@ export function mountViewer(root, transport) {
     const marks = frame && scene?.has_charges && { positions: frame.positions, charges: state.charges, radii: state.radii, n: frame.n };
     const ringed = scene && particleAt(scene.highlight ?? null);
     const highlight = ringed && { x: ringed[0], y: ringed[1], radius: state.radii[scene.highlight] ?? 0, label: scene.highlight_label };
-    overlay.draw({ marks, highlight, trace, tracedAt, drag });
+    const grip = movableWall.face(frame);
+    overlay.draw({ marks, highlight, trace, tracedAt, drag, grip });
   }
 
   /** Matches both canvases to the vessel's size in device pixels and redraws at once. */
@@ -188,9 +194,11 @@ export function mountViewer(root, transport) {
 
   // --- pointer: trace and drag ----------------------------------------------------------------
 
-  /** The particle whose centre is nearest (cssX, cssY) within its radius + a few pixels. */
+  /** The movable wall (WALL) if (cssX, cssY) is on its face, else the particle whose centre is
+   * nearest within its radius + a few pixels. */
   function pick(cssX, cssY) {
     const frame = state.drawnFrame;
+    if (movableWall.grabs(frame, cssX, cssY)) return WALL;
     if (!frame) return null;
     const [x, y] = viewport.cssToWorld(cssX, cssY);
     const slack = PICK_SLACK_PX / viewport.pixelsPerMetre;
@@ -209,14 +217,24 @@ export function mountViewer(root, transport) {
 
   const detachPointer = attachPointer(layout.overlay, pick, {
     onClick(index) {
-      send({ type: "trace", index });
+      if (index !== WALL) send({ type: "trace", index });
     },
     onDrag(index, cssX, cssY) {
+      if (index === WALL) {
+        state.draggingWall = true;
+        movableWall.drag(cssX, cssY);
+        return;
+      }
       state.drag = { index, pointer: viewport.cssToWorld(cssX, cssY) };
       state.overlayDirty = true;
       requestRender();
     },
     onDrop(index, cssX, cssY) {
+      if (index === WALL) {
+        state.draggingWall = false;
+        movableWall.drop(cssX, cssY);
+        return;
+      }
       const centre = particleAt(index);
       const [x, y] = viewport.cssToWorld(cssX, cssY);
       // The displacement in metres is read as the new velocity in m/s.
@@ -226,11 +244,21 @@ export function mountViewer(root, transport) {
       requestRender();
     },
     onCancel() {
+      if (state.draggingWall) send({ type: "move_wall", to: null });
+      state.draggingWall = false;
       state.drag = null;
       state.overlayDirty = true;
       requestRender();
     },
   });
+
+  // The cursor says where the wall can be grabbed.
+  function hover(event) {
+    const rect = layout.overlay.getBoundingClientRect();
+    const onWall = movableWall.grabs(state.drawnFrame, event.clientX - rect.left, event.clientY - rect.top);
+    layout.overlay.style.cursor = onWall || state.draggingWall ? movableWall.cursor : "";
+  }
+  layout.overlay.addEventListener("pointermove", hover);
 
   // --- messages -------------------------------------------------------------------------------
 
@@ -239,7 +267,9 @@ export function mountViewer(root, transport) {
     state.stats = null;
     state.radii = perParticle(scene.radius, scene.n | 0, 0);
     state.charges = perParticle(scene.charge, scene.n | 0, 0);
-    state.decorated = Boolean(scene.has_charges) || Number.isInteger(scene.highlight);
+    movableWall.setScene(scene);
+    state.draggingWall = false;
+    state.decorated = Boolean(scene.has_charges) || Number.isInteger(scene.highlight) || movableWall.present;
     layout.explanation.textContent = scene.explanation ?? "";
     layout.explanation.hidden = !scene.explanation;
     state.pendingFrame = null;
@@ -251,6 +281,8 @@ export function mountViewer(root, transport) {
     renderer.setScene(scene);
     trace.follow(null);
     energyPlot.clear();
+    energyPlot.setForces(Boolean(scene.has_forces));
+    totalSpeedPlot.clear();
     speedPlot.clear();
     readouts.reset(scene.n);
     instruments.reset();
@@ -279,6 +311,7 @@ export function mountViewer(root, transport) {
     if (stats.warning && !state.warnedDrift) report("energy", stats.warning); // once a scene
     state.warnedDrift = Boolean(stats.warning);
     energyPlot.append(stats);
+    totalSpeedPlot.append(stats);
     speedPlot.update(stats.histogram);
   }
 
@@ -385,6 +418,10 @@ export function mountViewer(root, transport) {
     },
     /** Where the point (x, y) m is on the vessel's canvas, in CSS pixels from its corner. */
     toCanvas: (x, y) => viewport.worldToCss(x, y),
+    /** The movable wall's face as drawn, [[x0, y0], [x1, y1]] m, or null. */
+    get wallFace() {
+      return movableWall.face(state.drawnFrame);
+    },
     get pixelsPerMetre() {
       return viewport.pixelsPerMetre;
     },
@@ -397,6 +434,10 @@ export function mountViewer(root, transport) {
     },
     get energyPoints() {
       return energyPlot.points;
+    },
+    /** The energy plot's lines shown, by label. */
+    get energyLines() {
+      return energyPlot.shown;
     },
     get connected() {
       return state.connected;
@@ -416,9 +457,12 @@ export function mountViewer(root, transport) {
     window.removeEventListener("resize", resizeVessel);
     page.removeEventListener("visibilitychange", resumeWhenVisible);
     detachPointer();
+    layout.overlay.removeEventListener("pointermove", hover);
+    movableWall.destroy();
     controls.destroy();
     messageBar.destroy();
     energyPlot.destroy();
+    totalSpeedPlot.destroy();
     speedPlot.destroy();
     renderer.destroy();
     transport.close();

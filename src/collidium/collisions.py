@@ -132,6 +132,10 @@ class Drift(Protocol):
     def load_state(self, arrays: dict[str, np.ndarray]) -> None:
         """Take back what `state` returned."""
 
+    def forget(self) -> None:
+        """Drop what the mode keeps of the vessel (the next drift starts afresh): the vessel
+        has changed."""
+
 
 #: Normal approach speed (m/s) below which an inelastic pair collision is elastic: the guard
 #: against inelastic collapse, where a cluster of disks would collide infinitely often in a
@@ -190,6 +194,9 @@ class _Stateless:
 
     def load_state(self, arrays: dict[str, np.ndarray]) -> None:
         """Nothing to restore."""
+
+    def forget(self) -> None:
+        """Nothing kept."""
 
 
 class NoCollisions(_Stateless):
@@ -391,6 +398,11 @@ class ExactCollisions:
         )
         self._state = _restored(queue) if usable else None
         self._synced_at = float(arrays["synced_at"][0]) if usable else 0.0
+
+    def forget(self) -> None:
+        """Drop the event queue (its arrays are reused by the next rebuild)."""
+        if self._state is not None:
+            self._spare, self._state = self._state, None
 
     def _is_current(self, particles: Particles, piston: FloatArray) -> bool:
         s = self._state

@@ -176,7 +176,7 @@ class Simulation:
         name: str | None,
         restitution: float = 1.0,
     ) -> None:
-        self.container = container
+        self._container = container
         self.particles = particles
         self._dt = float(dt)
         self._time_origin = (0.0, 0)  # (time, steps) when dt was last set
@@ -192,6 +192,39 @@ class Simulation:
         self._drift = make_drift(collisions, self._restitution)
         self._integrator = make_integrator("adaptive", DEFAULT_TOLERANCE)
         self.tally = Tally.for_vessel(container)
+
+    @property
+    def container(self) -> Vessel:
+        """The vessel; may be replaced between runs by one with the same walls and other
+        responses (`collidium.vessels.Vessel.with_walls`): walls held hot, a wall turned into a
+        piston, a piston driven or let go.
+
+        A piston on the wall that already was one keeps where it is and, unless the new one is
+        driven (moved at its own velocity), how fast it moves; a new piston starts at its
+        ``position`` and ``velocity``.
+
+        Raises
+        ------
+        InputError
+            If the walls differ, a particle would lie beyond the new piston, or the vessel does
+            not suit the forces or the collision mode. Nothing changes then.
+        """
+        return self._container
+
+    @container.setter
+    def container(self, vessel: Vessel) -> None:
+        _check_setup(vessel, self.particles, self.forces, self.dt, self.collisions)
+        if vessel.wall_names != self._container.wall_names or type(vessel) is not type(
+            self._container
+        ):
+            raise InputError(
+                "container", f"must have the walls of the {self._container.describe()} "
+                "(give them other responses); start a new simulation for another vessel"
+            )  # fmt: skip
+        piston = _carried_piston(self._container, vessel, self.tally.piston)
+        _check_placement(vessel, self.particles, self.collisions, *piston[:1])
+        self._container, self.tally.piston = vessel, piston
+        self._drift.forget()  # its queue holds the old piston
 
     @property
     def dt(self) -> float:
@@ -697,6 +730,24 @@ def overlap_detail(container: Vessel, particles: Particles, i: int, j: int) -> s
     gap = np.linalg.norm(container.minimum_image(particles.position[j] - particles.position[i]))
     radius = particles.radius
     return f"(centres {gap:g} m apart, radii {radius[i]:g} + {radius[j]:g})"
+
+
+def _carried_piston(old: Vessel, new: Vessel, state: FloatArray) -> FloatArray:
+    """`collidium.collisions.Tally.piston` for ``new`` replacing ``old`` whose piston is at
+    ``state`` (position, velocity) (see `Simulation.container`)."""
+    if new.piston is None:
+        return np.empty(0)
+    wall, piston = new.piston
+    if old.piston is None or old.piston[0] != wall:
+        return np.array([piston.position, piston.velocity], dtype=float)
+    if piston.driven and piston.stop is not None:
+        ahead = (piston.stop - state[0]) * piston.velocity
+        if ahead < 0:
+            raise InputError(
+                f"walls.{new.wall_names[wall]}.stop", f"is behind the piston's face, at "
+                f"{state[0]:.6g} m now: it must lie ahead of the piston's motion"
+            )  # fmt: skip
+    return np.array([state[0], piston.velocity if piston.driven else state[1]], dtype=float)
 
 
 def _check_placement(

@@ -209,3 +209,53 @@ def test_a_piston_needs_exact_collisions_no_forces_and_the_gas_behind_it():
     with pytest.raises(InputError, match="outside") as caught:
         Simulation(box, above)
     assert caught.value.field == "position"
+
+
+def test_a_wall_becomes_a_driven_piston_between_runs_and_its_work_is_counted():
+    """Simulation.container replaced by the same box whose right wall is a piston driven in: it
+    starts where it is given, stops where asked, and the gas's energy gain is its work."""
+    box = Box(10.0, 10.0)
+    sim = Simulation(box, _gas(box, 80, 0.2, 3.0, seed=8), dt=0.05)
+    sim.run(time=1.0)
+    energy = sim.energy().kinetic
+    sim.container = box.with_walls(
+        {"right": Piston(position=5.0, velocity=-2.0, driven=True, stop=2.0)}
+    )
+    sim.run(time=3.0)
+    state = sim.piston()
+    assert state is not None and (state.position, state.velocity) == (2.0, 0.0)
+    assert sim.escaped() == 0 and (sim.particles.position[:, 0] + 0.2 <= 2.0 + 1e-12).all()
+    assert sim.energy().kinetic - energy == pytest.approx(state.work, rel=1e-12)
+    assert state.work > 0  # compressing heats
+
+
+def test_a_piston_kept_on_its_wall_keeps_where_it_is_unless_driven():
+    box = Box(12.0, 12.0, walls={"top": Piston(position=2.0, mass=2.0, force=15.0)})
+    sim = Simulation(box, _gas(box, 40, 0.2, 3.0, seed=9), dt=0.05)
+    sim.run(time=2.0)
+    position, velocity = sim.tally.piston
+    sim.container = box.with_walls({})  # the same box: the piston goes on as it was
+    assert list(sim.tally.piston) == [position, velocity]
+    with pytest.raises(InputError, match="behind the piston's face") as caught:
+        sim.container = box.with_walls(
+            {"top": Piston(position=position - 1.0, velocity=1.0, driven=True, stop=position - 0.5)}
+        )
+    assert caught.value.field == "walls.top.stop"
+    driven = Piston(position=position, velocity=1.0, driven=True, stop=position + 0.5)
+    sim.container = box.with_walls({"top": driven})
+    assert list(sim.tally.piston) == [position, 1.0]  # a driven piston moves at its velocity
+    sim.run(time=5.0)
+    assert sim.piston().position == position + 0.5
+
+
+def test_a_replaced_vessel_must_have_the_same_walls_and_hold_the_gas():
+    box = Box(10.0, 10.0)
+    sim = Simulation(box, _gas(box, 30, 0.2, 3.0, seed=10), dt=0.05)
+    before = sim.container
+    with pytest.raises(InputError, match="must have the walls of the 10 x 10 box") as caught:
+        sim.container = Circle(6.0)
+    assert caught.value.field == "container"
+    with pytest.raises(InputError, match="outside") as caught:
+        sim.container = box.with_walls({"right": Piston(position=-4.9, driven=True)})
+    assert caught.value.field == "position"
+    assert sim.container is before and sim.tally.piston.size == 0  # nothing changed

@@ -497,3 +497,84 @@ def test_the_pump_lets_particles_in_and_out(page):
     page.fill("#pump-count", "0")
     page.click("#pump-in")
     assert page.inner_text("#message").startswith('count: "0" is not a whole number')
+
+
+# -- dragging a wall, momentum arrows, energy lines ------------------------------------------
+
+
+def test_dragging_the_wall_by_its_grip_compresses_and_heats_the_gas(page):
+    page.wait_for_function(
+        "window.collidiumViewer.stats && window.collidiumViewer.stats.temperature > 0"
+    )
+    assert page.evaluate("window.collidiumViewer.wallFace") == [[10, -10], [10, 10]]
+    overlay = pixels(page, "#overlay")
+    x, y = page.evaluate("window.collidiumViewer.toCanvas(10, 0)")
+    grip = overlay[round(y) - 12 : round(y) + 13, round(x) - 2 : round(x) + 3]
+    assert (np.abs(grip - [0x8A, 0x5A, 0x2B]) <= 8).all(axis=2).mean() > 0.5  # the grip is drawn
+    before = readout(page, "temperature")
+    page.mouse.move(*on_screen(page, 10.0, 0.0))
+    page.mouse.down()
+    page.mouse.move(*on_screen(page, 0.0, 0.0), steps=10)
+    page.mouse.up()  # let go: the wall goes on to x = 0 and stays
+    page.wait_for_function(
+        "window.collidiumViewer.stats.piston && window.collidiumViewer.stats.piston.velocity === 0"
+        " && window.collidiumViewer.stats.piston.position < 1",
+        timeout=60_000,
+    )
+    box = page.locator("#particles").bounding_box()
+    pixel = 20.0 / (min(box["width"], box["height"]) - 4)  # a CSS pixel in m
+    face = page.evaluate("window.collidiumViewer.wallFace")
+    assert abs(face[0][0]) <= 2 * pixel  # where the pointer was let go, to the pointer's pixel
+    # Half the area: a little more than twice the temperature (the gas is not dilute).
+    page.wait_for_function(f"window.collidiumViewer.stats.temperature > {1.9 * before}")
+
+
+TWO_AT_REST = """
+name = "two"
+[vessel]
+width = 20.0
+height = 20.0
+[[particles]]
+kind = "explicit"
+position = [[-5.0, 0.0], [8.0, -5.0]]  # the right one clear of the wall's grip
+velocity = [[0.0, 0.0], [0.0, 0.0]]
+radius = 1.0
+"""
+
+
+def test_momentum_arrows_have_heads_and_stop_at_the_wall(page):
+    page.set_input_files(
+        "#open-scenario",
+        files=[{"name": "two.toml", "mimeType": "text/plain", "buffer": TWO_AT_REST.encode()}],
+    )
+    page.wait_for_function("document.querySelector('#readout-n').dataset.value === '2'")
+    settled_pause(page)
+    hide_legend(page)
+    page.check("#toggle-momentum")
+    # Equal momenta: each arrow is two diameters (4 m) long; the right one points out of the box.
+    for index, (vx, vy) in enumerate([(0.0, 5.0), (5.0, 0.0)]):
+        page.evaluate(f"window.collidiumViewer.send({{type: 'set_velocity', index: {index}, "
+                      f"vx: {vx}, vy: {vy}}})")  # fmt: skip
+    page.wait_for_function("window.collidiumViewer.particle(1).vx === 5")
+    page.wait_for_timeout(300)
+    image = pixels(page, "#particles")
+    dark = (image < 200).all(axis=2)  # a 1 px line, anti-aliased: grey where it falls between
+    tip_x, tip_y = page.evaluate("window.collidiumViewer.toCanvas(-5, 4)")
+    row, column = round(tip_y) + 5, round(tip_x)
+    # Five pixels below the tip of the upward arrow: its shaft and, 2-4 px either side, a barb.
+    assert dark[row, column - 1 : column + 2].any()
+    assert dark[row, column - 5 : column - 1].any() and dark[row, column + 2 : column + 6].any()
+    assert not dark[round(tip_y) + 20, column - 6 : column - 2].any()  # no barbs lower down
+    # The right arrow is drawn up to the wall (x = 10 m) and not beyond it.
+    wall_x, wall_y = page.evaluate("window.collidiumViewer.toCanvas(10, -5)")
+    inside = dark[round(wall_y) - 1 : round(wall_y) + 2, round(wall_x) - 12 : round(wall_x) - 3]
+    outside = image[round(wall_y) - 3 : round(wall_y) + 4, round(wall_x) + 3 : round(wall_x) + 40]
+    assert inside.any(axis=0).all()
+    assert (np.abs(outside - LETTERBOX) <= 3).all()
+
+
+def test_the_energy_plot_shows_the_total_alone_without_forces(page):
+    assert page.evaluate("window.collidiumViewer.energyLines") == ["total"]
+    load_preset(page, "charged-gas")
+    assert page.evaluate("window.collidiumViewer.energyLines") == ["kinetic", "potential", "total"]
+    assert page.locator("#total-speed-plot canvas").count() > 0  # total speed: its own panel

@@ -10,7 +10,7 @@ from collidium.observers.thermo import Thermo
 from collidium.presets import PRESETS, preset
 from collidium.scenario import Scenario
 from collidium.theory import MaxwellBoltzmann2D
-from collidium.viewer import protocol
+from collidium.viewer import moving_wall, protocol
 from collidium.viewer import session as session_module
 from collidium.viewer.session import WINDOW_SAMPLES, ViewerSession
 
@@ -392,3 +392,88 @@ def test_a_periodic_box_has_no_hatch():
     periodic = ViewerSession(preset("granular", n=50), preset="granular")
     with pytest.raises(InputError, match="pump: a periodic box has no wall to pump through"):
         periodic.pump(5)
+
+
+# -- dragging a wall -----------------------------------------------------------------------
+
+
+def until_the_wall_stops(session: ViewerSession) -> None:
+    """Run until the dragged wall has reached its target (a driven piston halts there)."""
+    for _ in range(10_000):
+        session.sim.run(steps=10)
+        state = session.sim.piston()
+        if state is not None and state.velocity == 0.0:
+            return
+    raise AssertionError("the wall never arrived")
+
+
+def test_dragging_a_wall_in_heats_a_dilute_gas_along_its_adiabat_and_out_cools_it():
+    """T A is constant for a slowly compressed dilute 2D gas (2 degrees of freedom): halving the
+    area doubles kT. The wall moves at a fifth of the rms speed: its irreversible heating adds
+    a few percent, within the 10% allowed. The work it does is counted as the wall's heat. Back
+    out, the gas cools, but over the cycle the wall has done work on it (the second law)."""
+    gas = ViewerSession(preset("gas", n=400, radius=0.05), preset="gas")
+    assert gas.scene()["movable_wall"]["name"] == "right"
+    kT = gas.sim.temperature()
+    gas.move_wall(0.0)  # the right wall from x = 10 m to 0: half the area
+    gas.move_wall(None)  # let go: a box's wall goes on to where it was sent
+    until_the_wall_stops(gas)
+    state = gas.sim.piston()
+    assert state.position == 0.0 and np.all(gas.sim.particles.position[:, 0] < 0.0)
+    assert gas.sim.temperature() / kT == pytest.approx(2.0, rel=0.1)
+    assert state.work == pytest.approx(gas.sim.energy().kinetic - 400 * kT, rel=1e-12)
+    assert abs(gas.stats()["drift"]) < 1e-12
+    compressed = gas.sim.temperature()
+    gas.move_wall(10.0)
+    until_the_wall_stops(gas)
+    assert gas.sim.temperature() < 0.6 * compressed
+    assert gas.sim.piston().work > 0.0 and gas.sim.temperature() > kT
+
+
+def test_a_drag_stops_where_the_gas_would_be_squeezed_too_dense():
+    gas = ViewerSession(preset("gas", n=200), preset="gas")
+    wall = gas.scene()["movable_wall"]
+    gas.move_wall(-1e9)
+    until_the_wall_stops(gas)
+    assert gas.sim.piston().position == wall["low"] > -10.0
+    area = (wall["low"] + 10.0) * 20.0
+    disks = float(np.sum(np.pi * gas.sim.particles.radius**2))
+    assert disks / area == pytest.approx(moving_wall.MAX_PACKING, rel=1e-12)
+    assert gas.sim.escaped() == 0
+
+
+def test_a_free_piston_is_driven_while_dragged_and_free_once_let_go():
+    piston = ViewerSession(preset("piston", n=50), preset="piston")
+    piston.sim.run(steps=5)
+    start = piston.sim.piston().position
+    piston.move_wall(start - 5.0)
+    assert piston.sim.container.piston[1].driven
+    until_the_wall_stops(piston)
+    assert piston.sim.piston().position == pytest.approx(start - 5.0, abs=1e-12)
+    piston.move_wall(None)
+    own = piston.sim.container.piston[1]
+    assert not own.driven and own.mass == 20.0
+    assert piston.sim.piston().position == pytest.approx(start - 5.0, abs=1e-12)
+    piston.sim.run(steps=50)  # the weight and the gas move it again
+    assert piston.sim.piston().velocity != 0.0
+
+
+def test_a_moved_wall_stays_while_the_walls_are_held_hot():
+    gas = ViewerSession(preset("gas", n=100), preset="gas")
+    gas.move_wall(5.0)
+    until_the_wall_stops(gas)
+    gas.hold_wall_temperature(2.0)
+    walls = gas.sim.container.walls
+    assert type(walls["right"]).__name__ == "Piston"
+    assert {type(walls[name]).__name__ for name in ("left", "bottom", "top")} == {"Thermal"}
+    gas.sim.run(steps=20)
+    gas.hold_wall_temperature(None)
+    assert gas.sim.piston().position == 5.0 and gas.sim.container.walls["right"].driven
+
+
+def test_only_a_box_in_the_exact_engine_without_forces_has_a_wall_to_drag():
+    for name in ("charged-gas", "circle-gas", "hard-disks"):
+        session = ViewerSession(preset(name), preset=name)
+        assert session.scene()["movable_wall"] is None, name
+        with pytest.raises(InputError, match="wall: only a box with exact collisions"):
+            session.move_wall(1.0)

@@ -183,6 +183,8 @@ class Connection:
             case protocol.Pump(count=count, temperature=kT):
                 s.pump(count, kT)
                 return [s.scene(), s.status(), self._stats()]
+            case protocol.MoveWall(to=to):
+                s.move_wall(to)
             case protocol.HistogramWindow(readouts=readouts):
                 s.set_histogram_window(readouts)
             case protocol.Reset():

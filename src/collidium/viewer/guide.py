@@ -46,7 +46,8 @@ GUIDES: dict[str, Guide] = {
     "gas": Guide(
         "Disks that start with one speed soon share out their energy: the histogram settles "
         "onto the Maxwell-Boltzmann curve. Heat or cool the gas and watch the thermometer and "
-        "the pressure gauge move together (PA = NkT)."
+        "the pressure gauge move together (PA = NkT). Drag the grip on the right wall inwards: "
+        "the gas heats as it is squeezed."
     ),
     "charged-like": Guide(
         "Two like charges slow each other down and turn back before they touch: kinetic energy "
@@ -112,7 +113,8 @@ GUIDES: dict[str, Guide] = {
     ),
     "piston": Guide(
         "A weighted piston squeezes the gas until the gas pushes back as hard as the weight "
-        "(P L = F). Heat the gas: the piston rises.",
+        "(P L = F). Heat the gas: the piston rises. Drag the piston down and let it go: it "
+        "bounces on the gas.",
     ),
     "effusion": Guide(
         "Light and heavy disks leak through a hole: the light ones escape faster, in the ratio "

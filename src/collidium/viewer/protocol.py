@@ -16,6 +16,8 @@ Front end to server (validated by `parse_message`; a bad one gets an ``error`` r
                                              continuously); null gives them back
     pump           count: int, temperature   let particles in through the hatch at kT (J; null:
                                              the gas's), or out (count < 0)
+    move_wall      to: float | null          drag the scene's movable wall towards a coordinate
+                                             along its axis (m); null lets go
     histogram_window  readouts: int          average the speed histogram over the last readouts
     trace          index: int | null         follow a particle's path (null: none)
     set_velocity   index: int, vx, vy        m/s
@@ -26,8 +28,9 @@ Front end to server (validated by `parse_message`; a bad one gets an ``error`` r
 
 Server to front end (JSON): ``hello`` (version; presets with their explanation and the controls
 of their parameters: name, label, unit, kind, default, choices; limits), ``scene`` (vessel
-outline and walls, per-particle radius, charge, mass and species, the colour modes that apply,
-the highlighted particle, the preset's explanation; sent again after load, scenario and reset),
+outline and walls, per-particle radius, charge, mass and species, whether forces act, the
+colour modes that apply, the highlighted particle, the preset's explanation, the wall that may
+be dragged (name, axis, rest, low, high) or null; sent again after load, scenario and reset),
 ``status`` (playing, speed, toggles, colour mode), ``stats`` (time, readouts, energies, speed
 histogram with its Maxwell-Boltzmann curve), ``traced``, ``export`` (filename, toml) and
 ``error`` (field, reason).
@@ -149,6 +152,11 @@ class Pump(_Message):
     ) = None
 
 
+class MoveWall(_Message):
+    type: Literal["move_wall"]
+    to: Annotated[float, Field(allow_inf_nan=False)] | None
+
+
 class HistogramWindow(_Message):
     type: Literal["histogram_window"]
     readouts: Annotated[int, Field(ge=1, le=MAX_HISTOGRAM_WINDOW)]
@@ -186,7 +194,7 @@ class Raw(_Message):
 
 Message = Annotated[
     Ready | Ack | Play | Pause | Step | Reset | Export | Speed | Heat | Toggle | Colour
-    | WallTemperature | Pump | HistogramWindow | Trace
+    | WallTemperature | Pump | MoveWall | HistogramWindow | Trace
     | SetVelocity | Load | ScenarioText | Raw,
     Field(discriminator="type"),
 ]  # fmt: skip
@@ -194,7 +202,7 @@ _MESSAGE: TypeAdapter[Message] = TypeAdapter(Message)
 #: The ``type`` of each message the front end may send.
 MESSAGE_TYPES = (
     "ready", "ack", "play", "pause", "step", "reset", "export", "speed", "heat", "collisions",
-    "charges", "momentum", "colour", "wall_temperature", "pump", "histogram_window",
+    "charges", "momentum", "colour", "wall_temperature", "pump", "move_wall", "histogram_window",
     "trace",
     "set_velocity", "load", "scenario", "raw",
 )  # fmt: skip

@@ -26,10 +26,11 @@ from collidium.simulation import Simulation
 from collidium.state import PROPERTIES, FloatArray, Particles, uniform_or_each
 from collidium.theory import MaxwellBoltzmann2D
 from collidium.vessels import Vessel
-from collidium.vessels.walls import Thermal
+from collidium.vessels.walls import Thermal, WallResponse
 from collidium.viewer import protocol
 from collidium.viewer.builder import BUILDER
 from collidium.viewer.guide import ColourMode, guide, parameter_specs
+from collidium.viewer.moving_wall import SPEED_FRACTION, movable_wall
 
 #: Bins of the live speed histogram.
 HISTOGRAM_BINS = 30
@@ -104,6 +105,11 @@ class ViewerSession:
         #: kT (J) of the thermal walls held while heating or cooling continuously, or None.
         self.wall_temperature: float | None = None
         self._vessel = sim.container  # with its own walls, given back when the hold ends
+        self._movable = movable_wall(sim, self._vessel)
+        # Where the dragged wall is headed (m along its axis) and how fast (m/s); a box's wall
+        # keeps its target after the drag, a free piston is let go.
+        self._wall_target: float | None = None
+        self._wall_speed = 0.0
         self.histogram_window = 1
         # (upper speed, density, time, kT) of the last readouts' histograms
         self._histograms: deque[tuple[float, FloatArray, float, float]] = deque(
@@ -179,20 +185,56 @@ class ViewerSession:
     def hold_wall_temperature(self, kT: float | None) -> None:
         """Make the vessel's walls thermal walls at ``kT`` (J), heating or cooling the gas
         continuously through them, until called with None, which gives the walls back their
-        own responses (a piston stays a piston). The energy they exchange is counted as wall
-        heat, so the energy drift readout stays that of the dynamics."""
-        vessel = self._vessel
-        if kT is None:
-            self.sim.container = vessel
-        else:
-            piston = vessel.piston
-            walls = [name for k, name in enumerate(vessel.shape_walls)
-                     if piston is None or k != piston[0]]  # fmt: skip
-            if not walls:
-                raise InputError("temperature", "a periodic box has no walls to heat through; "
-                                 "use the heat and cool buttons")  # fmt: skip
-            self.sim.container = vessel.with_walls({name: Thermal(kT) for name in walls})
+        own responses (a piston, and a wall the user has moved, stay as they are). The energy
+        they exchange is counted as wall heat, so the energy drift readout stays that of the
+        dynamics."""
+        if kT is not None and not self._heatable_walls():
+            raise InputError("temperature", "a periodic box has no walls to heat through; "
+                             "use the heat and cool buttons")  # fmt: skip
         self.wall_temperature = kT
+        self._set_walls()
+
+    def move_wall(self, to: float | None) -> None:
+        """Drag the vessel's movable wall (`collidium.viewer.moving_wall`) towards ``to`` (m, a
+        coordinate along its axis, kept within its range) as a driven piston moving at
+        `SPEED_FRACTION` of the gas's rms speed: compressing heats the gas, expanding cools
+        it, and the work done is counted as that wall's heat. None lets go: a free piston
+        moves freely again, a box's wall goes on to where it was last sent and stays there."""
+        wall = self._movable
+        if wall is None:
+            raise InputError("wall", "only a box with exact collisions and no forces has a wall "
+                             "to move")  # fmt: skip
+        if to is None:
+            if wall.piston is not None:
+                self._wall_target = None
+        else:
+            self._wall_target = min(max(to, wall.low), wall.high)
+            p = self.sim.particles
+            rms = math.sqrt(2.0 * self.sim.energy().kinetic / float(np.sum(p.mass))) if p.n else 0
+            # A gas at rest: across the range in 1 s.
+            self._wall_speed = SPEED_FRACTION * rms or (wall.high - wall.low)
+        self._set_walls()
+
+    def _heatable_walls(self) -> list[str]:
+        """The vessel's walls but its piston and the wall the user has moved."""
+        vessel = self._vessel
+        moving = {vessel.piston[0]} if vessel.piston is not None else set()
+        if self._movable is not None and self._wall_target is not None:
+            moving.add(self._movable.wall)
+        return [name for k, name in enumerate(vessel.shape_walls) if k not in moving]
+
+    def _set_walls(self) -> None:
+        """The simulation's vessel: its own, with the walls held at `wall_temperature` and the
+        dragged wall driven towards its target from where it is now."""
+        responses: dict[str, WallResponse] = {}
+        if self.wall_temperature is not None:
+            responses |= {name: Thermal(self.wall_temperature) for name in self._heatable_walls()}
+        wall = self._movable
+        if wall is not None and self._wall_target is not None:
+            state = self.sim.piston()
+            at = wall.rest if state is None or state.wall != wall.name else state.position
+            responses[wall.name] = wall.driven(at, self._wall_target, self._wall_speed)
+        self.sim.container = self._vessel.with_walls(responses) if responses else self._vessel
 
     def pump(self, count: int, kT: float | None = None) -> int:
         """Let ``count`` particles in through the hatch (the middle of the vessel's first wall)
@@ -380,10 +422,12 @@ class ViewerSession:
             },
             "radius": _compact(p.radius), "charge": _compact(p.charge),
             "mass": _compact(p.mass), "dt": sim.dt, "collisions": self._mode,
+            "has_forces": bool(self._forces),
             "has_charges": bool(self._forces) and bool(np.any(p.charge != 0)),
             "species": _compact(self._species.astype(float)) if p.n else 0.0,
             "species_labels": self._species_labels, "colour_modes": self._colour_modes(),
             "explanation": notes.explanation, "highlight": highlight,
+            "movable_wall": None if self._movable is None else self._movable.to_dict(),
             "highlight_label": notes.highlight_label if highlight is not None else "",
         }  # fmt: skip
 
@@ -395,7 +439,7 @@ class ViewerSession:
             "collisions": self.collisions_enabled, "charges": self.charges_enabled,
             "momentum": self.momentum, "colour": self.colour,
             "wall_temperature": self.wall_temperature, "histogram_window": self.histogram_window,
-            "has_walls": bool(self._vessel.shape_walls),
+            "has_walls": bool(self._vessel.shape_walls), "wall_target": self._wall_target,
             "phase": "starting" if self.starting else "running",
         }  # fmt: skip
 
