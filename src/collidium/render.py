@@ -137,7 +137,10 @@ def energy_figure(trajectory: Trajectory) -> Figure:
     """
     _require_frames(trajectory)
     figure = _figure(7.0, 5.2)
-    energy, speed = figure.subplots(2, 1, sharex=True, height_ratios=(3, 1))
+    grid = figure.add_gridspec(2, 1, height_ratios=(3, 1))
+    energy = figure.add_subplot(grid[0])
+    speed = figure.add_subplot(grid[1], sharex=energy)
+    energy.tick_params(labelbottom=False)  # the time axis is the panel's below
     _energy_plot(energy, trajectory, speed)
     figure.suptitle(f"energy of {trajectory.n} particles")
     return figure

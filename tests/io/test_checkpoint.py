@@ -86,7 +86,7 @@ def test_save_writes_nothing_partial_and_replaces_atomically(tmp_path, monkeypat
     def fail(*args, **kwargs):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(np, "savez", fail)
+    monkeypatch.setattr(np.lib.format, "write_array", fail)
     with pytest.raises(InputError, match="cannot write: No space left on device") as caught:
         sim.run(steps=3).save(target)
     assert caught.value.field == str(target)
@@ -158,3 +158,14 @@ def test_the_vessel_is_saved_and_checkpoints_that_name_a_box_still_restore(tmp_p
     assert again.container.to_dict() == sim.container.to_dict()
     np.testing.assert_array_equal(again.run(steps=5).particles.position,
                                   sim.run(steps=5).particles.position)  # fmt: skip
+
+
+def test_arrays_of_objects_are_refused_not_pickled_and_nothing_is_left(tmp_path):
+    path = tmp_path / "objects.ckpt"
+    with pytest.raises(ValueError, match="allow_pickle=False"):
+        write_checkpoint(path, {"bad": np.array([{"a": 1}], dtype=object)}, {})
+    assert list(tmp_path.iterdir()) == []
+    write_checkpoint(path, {"good": np.arange(3.0)}, {"note": "x"})
+    arrays, meta = read_checkpoint(path)
+    np.testing.assert_array_equal(arrays["good"], np.arange(3.0))
+    assert meta["note"] == "x"

@@ -272,12 +272,21 @@ def test_holes_are_counted_as_unwritten_bytes(tmp_path):
     assert unwritten_bytes(path) == 0
 
 
+def with_a_hole(path) -> None:
+    """Make sure ``path`` ends in a hole, as gsd 4 and later leave when they grow a file's index
+    by extending the file (gsd 3 writes its index out)."""
+    if unwritten_bytes(path) == 0:
+        with path.open("r+b") as stream:
+            stream.truncate(path.stat().st_size + (1 << 20))
+    assert unwritten_bytes(path) > 0
+
+
 def test_a_full_disk_reads_without_the_memory_map(tmp_path, monkeypatch):
     """gsd maps a file's index, which it grows by extending the file (a hole); on a full tmpfs,
     reading a mapped hole kills the process (SIGBUS). With no room for the holes, the file is
     read through gsd's pure-Python reader instead, to the same arrays."""
     _, path = record(tmp_path, preset="gas", every=1, steps=150, n=20)
-    assert unwritten_bytes(path) > 0  # the index has grown
+    with_a_hole(path)
     mapped = read_trajectory(path)
 
     def refuse_to_map(*_args, **_kwargs):
@@ -294,6 +303,7 @@ def test_a_full_disk_reads_without_the_memory_map(tmp_path, monkeypatch):
 
 def test_appending_on_a_full_disk_is_refused_and_leaves_the_file(tmp_path, monkeypatch):
     sim, path = record(tmp_path, preset="gas", every=1, steps=150, n=20)
+    with_a_hole(path)
     before = path.read_bytes()
     full_disk(monkeypatch)
     with pytest.raises(InputError, match="cannot append: 0 bytes free") as caught:

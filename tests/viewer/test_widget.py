@@ -142,3 +142,18 @@ def test_the_widget_front_end_runs_in_chromium_against_the_widget(browser, viewe
     assert shown.simulation.time == stopped
     page.close()
     shown.close()
+
+
+def test_a_reloaded_page_gets_the_widget_back(widget):
+    """The view that was drawing is gone without acknowledging its frames (a notebook page
+    reload); the new one says ready and gets the handshake and frames again, paused or not."""
+    message(widget, {"type": "ready"})
+    message(widget, {"type": "pause"})
+    for _ in range(3):  # the old view's credit runs out
+        message(widget, {"type": "step"})
+    assert not [buffers for _, buffers in message(widget, {"type": "step"}) if buffers]
+    sent = message(widget, {"type": "ready"})
+    kinds = [content["type"] for content, _ in sent]
+    assert kinds[:4] == ["hello", "scene", "status", "stats"] and "frame" in kinds
+    (buffers,) = [buffers for content, buffers in sent if content["type"] == "frame"]
+    assert protocol.decode_frame(buffers[0])["time"] == widget.simulation.time

@@ -35,11 +35,14 @@ def write_checkpoint(path: str | Path, arrays: dict[str, np.ndarray], meta: dict
     """
     header = {"format": FORMAT, "version": VERSION} | meta
     encoded = np.frombuffer(json.dumps(header).encode("utf-8"), dtype=np.uint8)
-    pickled = [name for name, array in arrays.items() if array.dtype.hasobject]
-    if pickled:  # np.savez would pickle them (its allow_pickle needs NumPy 2.2)
-        raise ValueError(f"checkpoint arrays of Python objects: {pickled}")
     with replacing(path) as temporary, temporary.open("wb") as stream:
-        np.savez(stream, **({_META: encoded} | arrays))
+        # np.savez's layout, written here so that a write that fails closes the archive (NumPy 1
+        # leaves that to the garbage collector, which then writes to the closed file and prints
+        # a traceback) and arrays of objects are refused, never pickled.
+        with zipfile.ZipFile(stream, mode="w", allowZip64=True) as archive:
+            for name, array in ({_META: encoded} | arrays).items():
+                with archive.open(f"{name}.npy", mode="w", force_zip64=True) as member:
+                    np.lib.format.write_array(member, np.asanyarray(array), allow_pickle=False)
         stream.flush()
         os.fsync(stream.fileno())
 

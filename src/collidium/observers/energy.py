@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -133,7 +133,7 @@ def plot_energy(
     green = SEED_COLOURS["total_speed"]
     if speed_ax is None:
         ax.set_xlabel("time (s)")
-        speed_axis = ax.twinx()
+        speed_axis = cast("Axes", ax.twinx())  # typed as a base class by Matplotlib 3.8
         speed_axis.plot(time, total_speed, color=green, label="total speed")
         speed_axis.set_ylabel("total speed (m/s)", color=green)
         lines = ax.get_lines() + speed_axis.get_lines()

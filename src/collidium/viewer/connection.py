@@ -136,8 +136,11 @@ class Connection:
     def _apply(self, message: Any) -> list[Outgoing]:
         s = self.session
         if isinstance(message, protocol.Ready):
+            # A front end starting (again, after a notebook page reload) has drawn nothing:
+            # frames owed to a view that is gone are forgotten, the state now is sent at once.
             self.ready = True
-            self._last_tick = self._clock()
+            self._credit, self._framed, self._reported = MAX_CREDIT, -1, -1
+            self._last_tick = self._last_ack = self._clock()
             return [s.hello(), s.scene(), s.status(), self._stats()]
         if not self.ready:
             raise InputError("type", "send a ready message first")

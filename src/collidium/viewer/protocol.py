@@ -48,7 +48,7 @@ from __future__ import annotations
 import json
 import struct
 from collections.abc import Mapping
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, cast
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError
@@ -198,7 +198,8 @@ Message = Annotated[
     | SetVelocity | Load | ScenarioText | Raw,
     Field(discriminator="type"),
 ]  # fmt: skip
-_MESSAGE: TypeAdapter[Message] = TypeAdapter(Message)
+# (cast: pydantic < 2.7 types TypeAdapter's argument as a class, not any type form)
+_MESSAGE: TypeAdapter[Message] = TypeAdapter(cast(Any, Message))
 #: The ``type`` of each message the front end may send.
 MESSAGE_TYPES = (
     "ready", "ack", "play", "pause", "step", "reset", "export", "speed", "heat", "collisions",
