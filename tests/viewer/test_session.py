@@ -477,3 +477,16 @@ def test_only_a_box_in_the_exact_engine_without_forces_has_a_wall_to_drag():
         assert session.scene()["movable_wall"] is None, name
         with pytest.raises(InputError, match="wall: only a box with exact collisions"):
             session.move_wall(1.0)
+
+
+def test_the_hatch_stays_on_the_gas_side_of_a_moved_wall():
+    """With the right wall moved in to x = -4 m, the hatch is the middle of what is left of the
+    bottom wall, x = -7 m, and the particles pumped in arrive there."""
+    gas = ViewerSession(preset("gas", n=50), preset="gas")
+    gas.move_wall(-4.0)
+    until_the_wall_stops(gas)
+    before = gas.sim.particles.n
+    assert gas.pump(10, kT=4.0) > 5  # those that would overlap a disk near the hatch wait
+    arrived = gas.sim.particles.position[before:]
+    spacing = 2.0 * 0.25 * 1.05  # the row of ten along the wall, centred on the hatch
+    assert np.all(np.abs(arrived[:, 0] + 7.0) <= 5 * spacing) and np.all(arrived[:, 0] < -4.25)

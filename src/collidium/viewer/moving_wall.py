@@ -64,10 +64,13 @@ class MovableWall:
         return {"name": self.name, "axis": self.axis, "rest": self.rest, "low": self.low,
                 "high": self.high}  # fmt: skip
 
+    def clip(self, to: float) -> float:
+        """``to`` (m) kept within the range the face may be dragged over."""
+        return min(max(to, self.low), self.high)
+
     def driven(self, at: float, to: float, speed: float) -> Piston:
         """A piston whose face is at ``at`` (m) and moves at ``speed`` (m/s) towards ``to`` (m,
-        clipped to the wall's range), stopping there; at rest if already there."""
-        to = min(max(to, self.low), self.high)
+        within `clip`'s range), stopping there; at rest if already there."""
         restitution = 1.0 if self.piston is None else self.piston.restitution
         if to == at or speed <= 0.0:
             return Piston(position=at, driven=True, restitution=restitution)

@@ -22,7 +22,7 @@ from collidium.observers.speeds import SpeedHistogram
 from collidium.observers.thermo import Thermo
 from collidium.presets import PRESETS, describe_presets, preset
 from collidium.scenario import Scenario
-from collidium.simulation import Simulation
+from collidium.simulation import PistonState, Simulation
 from collidium.state import PROPERTIES, FloatArray, Particles, uniform_or_each
 from collidium.theory import MaxwellBoltzmann2D
 from collidium.vessels import Vessel
@@ -208,7 +208,7 @@ class ViewerSession:
             if wall.piston is not None:
                 self._wall_target = None
         else:
-            self._wall_target = min(max(to, wall.low), wall.high)
+            self._wall_target = wall.clip(to)
             p = self.sim.particles
             rms = math.sqrt(2.0 * self.sim.energy().kinetic / float(np.sum(p.mass))) if p.n else 0
             # A gas at rest: across the range in 1 s.
@@ -237,13 +237,14 @@ class ViewerSession:
         self.sim.container = self._vessel.with_walls(responses) if responses else self._vessel
 
     def pump(self, count: int, kT: float | None = None) -> int:
-        """Let ``count`` particles in through the hatch (the middle of the vessel's first wall)
+        """Let ``count`` particles in through the hatch (the middle of the vessel's first wall,
+        of the part of it on the gas's side of a piston)
         at temperature ``kT`` (J; default the gas's), or, with ``count`` < 0, let out the
         ``-count`` nearest the hatch. A particle let in is a copy of particle 0 (mass, radius,
         charge) with a velocity drawn as a thermal wall emits (`collidium.vessels.walls.Thermal`):
         those that would overlap another wait for a later pump. Returns how many went in or out.
         """
-        hatch, inward = _hatch(self._vessel)
+        hatch, inward = _hatch(self._vessel, self.sim.piston())
         p = self.sim.particles
         if count < 0:
             nearest = np.argsort(np.hypot(*(p.position - hatch).T))[: min(-count, p.n)]
@@ -583,12 +584,23 @@ def _species(particles: Particles) -> tuple[np.ndarray, list[str]]:
     return index.reshape(-1), labels
 
 
-def _hatch(vessel: Vessel) -> tuple[FloatArray, FloatArray]:
-    """The middle of the vessel's first wall and the unit normal into the vessel there."""
+def _hatch(vessel: Vessel, piston: PistonState | None) -> tuple[FloatArray, FloatArray]:
+    """The middle of the part of the vessel's first wall on the gas's side of its ``piston``
+    (a box's wall, `collidium.vessels.walls.Piston`), and the unit normal into the vessel
+    there."""
     outline = vessel.outline()
     if vessel.periodic or outline.shape[0] < 3:
         raise InputError("pump", "a periodic box has no wall to pump through")
     start, end = outline[0], outline[1]
+    if piston is not None:  # the gas lies where sign * x[axis] <= sign * face
+        wall = vessel.wall_names.index(piston.wall)
+        axis, sign = wall // 2, (1.0 if wall % 2 == 1 else -1.0)
+        beyond = [sign * point[axis] > sign * piston.position for point in (start, end)]
+        if beyond[0] != beyond[1]:
+            cut = start + (piston.position - start[axis]) / (end[axis] - start[axis]) * (
+                end - start
+            )
+            start, end = (cut, end) if beyond[0] else (start, cut)
     along = (end - start) / np.hypot(*(end - start))
     return 0.5 * (start + end), np.array([-along[1], along[0]])  # the outline turns left
 
