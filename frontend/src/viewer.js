@@ -244,7 +244,7 @@ export function mountViewer(root, transport) {
       requestRender();
     },
     onCancel() {
-      if (state.draggingWall) send({ type: "move_wall", to: null });
+      if (state.draggingWall) movableWall.cancel();
       state.draggingWall = false;
       state.drag = null;
       state.overlayDirty = true;

@@ -64,13 +64,19 @@ export function createMovableWall(viewport, send) {
     else if (!timer) timer = setTimeout(flush, wait);
   }
 
+  /** Let go: a free piston moves freely again (a box's wall goes on to the last place sent). */
+  function release() {
+    clearTimeout(timer);
+    timer = 0;
+    send({ type: "move_wall", to: null });
+  }
+
   /** Released at (cssX, cssY): the last place is sent, then the wall is let go. */
   function drop(cssX, cssY) {
     if (!wall) return;
-    clearTimeout(timer);
-    drag(cssX, cssY);
+    latest = viewport.cssToWorld(cssX, cssY)[wall.axis];
     flush();
-    send({ type: "move_wall", to: null });
+    release();
   }
 
   return {
@@ -79,6 +85,8 @@ export function createMovableWall(viewport, send) {
     grabs,
     drag,
     drop,
+    /** The drag was abandoned (the pointer was lost): the wall is let go where it is headed. */
+    cancel: release,
     /** The cursor over the face: a resize arrow along its axis. */
     get cursor() {
       return wall?.axis === 1 ? "ns-resize" : "ew-resize";

@@ -27,6 +27,7 @@ from collidium.kernels.cells import bounding_box, event_grid_shape, grid_window,
 from collidium.kernels.vessels import piston as piston_kernels
 from collidium.state import FloatArray, IntArray, Particles, as_given
 from collidium.vessels import Vessel
+from collidium.vessels.walls import wall_axis
 
 CollisionMode = Literal["exact", "step", "off"]
 COLLISION_MODES: tuple[CollisionMode, ...] = ("exact", "step", "off")
@@ -542,7 +543,7 @@ def _piston_now(piston: FloatArray, t: float) -> FloatArray:
     if piston.size == 0:
         return piston
     k = piston_kernels
-    sign = 1.0 if piston[k.WALL] % 2 == 1 else -1.0
+    _, sign = wall_axis(int(piston[k.WALL]))
     height, speed = k.motion(piston, t)
     return np.array([sign * height, sign * speed])
 

@@ -222,7 +222,7 @@ class Simulation:
                 "(give them other responses); start a new simulation for another vessel"
             )  # fmt: skip
         piston = _carried_piston(self._container, vessel, self.tally.piston)
-        _check_placement(vessel, self.particles, self.collisions, *piston[:1])
+        _check_inside(vessel, self.particles, *piston[:1])  # walls move no disk onto another
         self._container, self.tally.piston = vessel, piston
         self._drift.forget()  # its queue holds the old piston
 
@@ -750,14 +750,18 @@ def _carried_piston(old: Vessel, new: Vessel, state: FloatArray) -> FloatArray:
     return np.array([state[0], piston.velocity if piston.driven else state[1]], dtype=float)
 
 
-def _check_placement(
-    container: Vessel, particles: Particles, collisions: str, piston_at: float | None = None
-) -> None:
+def _check_inside(container: Vessel, particles: Particles, piston_at: float | None = None) -> None:
     outside = container.outside(particles.position, particles.radius, piston_at)
     if outside.size:
         i = int(outside[0])
         detail = outside_detail(container, particles, i)
         raise InputError("position", f"particle {i} {detail}", particles=(i,))
+
+
+def _check_placement(
+    container: Vessel, particles: Particles, collisions: str, piston_at: float | None = None
+) -> None:
+    _check_inside(container, particles, piston_at)
     if collisions == "off":
         return  # pass-through disks may overlap
     width, height = (float(side) for side in container.size)

@@ -17,7 +17,7 @@ from collidium.kernels.vessels import box as box_walls
 from collidium.state import BoolArray, FloatArray, IntArray
 from collidium.vessels.base import OUTSIDE_TOLERANCE, Vessel, check_extent
 from collidium.vessels.partitions import Partition
-from collidium.vessels.walls import Piston, WallResponse, piston_array
+from collidium.vessels.walls import Piston, WallResponse, piston_array, wall_axis
 
 Boundary = Literal["reflecting", "periodic"]
 BOUNDARIES: tuple[Boundary, ...] = ("reflecting", "periodic")
@@ -220,8 +220,8 @@ class Box(Vessel):
             raise InputError(f"vessel.walls.{found[1][0]}", "a box has at most one piston")
         if self.partitions:
             raise InputError(field, "a piston needs a box without partitions (it would cross them)")
-        half = 0.5 * float(self.size[WALLS.index(name) // 2])
-        sign = 1.0 if WALLS.index(name) % 2 == 1 else -1.0
+        axis, sign = wall_axis(WALLS.index(name))
+        half = 0.5 * float(self.size[axis])
         if not -half < sign * piston.position <= half:
             raise InputError(
                 f"{field}.position",
@@ -250,8 +250,7 @@ class Box(Vessel):
             return self
         wall, piston = self.piston
         face = piston.position if piston_at is None else piston_at
-        axis = wall // 2
-        sign = 1.0 if wall % 2 == 1 else -1.0
+        axis, sign = wall_axis(wall)
         sides = [self.width, self.height]
         sides[axis] = sign * face + 0.5 * sides[axis]
         return Box(sides[0], sides[1])
@@ -275,8 +274,8 @@ class Box(Vessel):
             return np.zeros(len(position), dtype=bool)
         wall, piston = self.piston
         face = piston.position if piston_at is None else piston_at
-        sign = 1.0 if wall % 2 == 1 else -1.0
-        reach = sign * (position[:, wall // 2] - face) + radius
+        axis, sign = wall_axis(wall)
+        reach = sign * (position[:, axis] - face) + radius
         return np.asarray(reach > OUTSIDE_TOLERANCE * 0.5 * float(self.size.max()))
 
     def describe(self) -> str:

@@ -169,6 +169,12 @@ RESPONSES: dict[str, type[WallResponse]] = {
 }
 
 
+def wall_axis(wall: int) -> tuple[int, float]:
+    """The axis a box wall's outward normal lies along (0: x, 1: y) and its sign (+1 for the
+    right and top walls), for the wall's index (0 left, 1 right, 2 bottom, 3 top)."""
+    return wall // 2, (1.0 if wall % 2 == 1 else -1.0)
+
+
 def piston_array(
     wall: int, piston: Piston, half: float, position: float, velocity: float, now: float
 ) -> FloatArray:
@@ -177,7 +183,7 @@ def piston_array(
     its face at ``position`` (m) moving at ``velocity`` (m/s), both along the axis, at time
     ``now`` (s)."""
     k = piston_kernels
-    sign = 1.0 if wall % 2 == 1 else -1.0
+    _, sign = wall_axis(wall)
     array = np.zeros(k.PISTON_SIZE)
     array[k.WALL] = wall
     array[k.HEIGHT], array[k.SPEED], array[k.STAMP] = sign * position, sign * velocity, now

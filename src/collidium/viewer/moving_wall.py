@@ -16,7 +16,7 @@ import numpy as np
 
 from collidium.simulation import Simulation
 from collidium.vessels import Box, Vessel
-from collidium.vessels.walls import Piston, Specular
+from collidium.vessels.walls import Piston, Specular, wall_axis
 
 #: Densest the gas may be squeezed by dragging: the fraction of the gas's side of the box that
 #: its disks cover (hard disks jam near 0.82).
@@ -57,7 +57,7 @@ class MovableWall:
     @property
     def axis(self) -> int:
         """0: the face moves along x; 1: along y."""
-        return self.wall // 2
+        return wall_axis(self.wall)[0]
 
     def to_dict(self) -> dict[str, Any]:
         """As the viewer's scene message sends it."""
@@ -99,7 +99,7 @@ def movable_wall(sim: Simulation, vessel: Vessel) -> MovableWall | None:
 def _travel(vessel: Box, sim: Simulation, wall: int, piston: Piston | None) -> MovableWall:
     """The wall with its range: from the box's edge inwards until the gas's disks would cover
     `MAX_PACKING` of its side (or be squeezed below two diameters across)."""
-    axis, sign = wall // 2, (1.0 if wall % 2 == 1 else -1.0)
+    axis, sign = wall_axis(wall)
     half = 0.5 * float(vessel.size[axis])
     across = float(vessel.size[1 - axis])
     radius = sim.particles.radius

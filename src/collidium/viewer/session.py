@@ -26,7 +26,7 @@ from collidium.simulation import PistonState, Simulation
 from collidium.state import PROPERTIES, FloatArray, Particles, uniform_or_each
 from collidium.theory import MaxwellBoltzmann2D
 from collidium.vessels import Vessel
-from collidium.vessels.walls import Thermal, WallResponse
+from collidium.vessels.walls import Thermal, WallResponse, wall_axis
 from collidium.viewer import protocol
 from collidium.viewer.builder import BUILDER
 from collidium.viewer.guide import ColourMode, guide, parameter_specs
@@ -440,7 +440,7 @@ class ViewerSession:
             "collisions": self.collisions_enabled, "charges": self.charges_enabled,
             "momentum": self.momentum, "colour": self.colour,
             "wall_temperature": self.wall_temperature, "histogram_window": self.histogram_window,
-            "has_walls": bool(self._vessel.shape_walls), "wall_target": self._wall_target,
+            "has_walls": bool(self._vessel.shape_walls),
             "phase": "starting" if self.starting else "running",
         }  # fmt: skip
 
@@ -452,7 +452,7 @@ class ViewerSession:
         energy = sim.energy()
         n = sim.particles.n
         kT = energy.kinetic / n if n else None
-        conserved = conserved_energy(sim)
+        conserved = conserved_energy(sim, energy)
         drift = (conserved - self._reference) / abs(self._reference) if self._reference else None
         if drift is not None and math.isfinite(drift):
             self._worst_drift = max(self._worst_drift, abs(drift))
@@ -594,7 +594,7 @@ def _hatch(vessel: Vessel, piston: PistonState | None) -> tuple[FloatArray, Floa
     start, end = outline[0], outline[1]
     if piston is not None:  # the gas lies where sign * x[axis] <= sign * face
         wall = vessel.wall_names.index(piston.wall)
-        axis, sign = wall // 2, (1.0 if wall % 2 == 1 else -1.0)
+        axis, sign = wall_axis(wall)
         beyond = [sign * point[axis] > sign * piston.position for point in (start, end)]
         if beyond[0] != beyond[1]:
             cut = start + (piston.position - start[axis]) / (end[axis] - start[axis]) * (
