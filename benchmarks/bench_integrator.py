@@ -6,8 +6,11 @@ I1  the seed's charged scenes at their defaults (dt = 0.01 s): wall seconds and 
     charged-opposite, charged-like).
 I2  energy error against tolerance: the adaptive integrator on orbit and bohr-atom (20 s) at
     tolerances from 4e-3 down to the default; second order, so halving the tolerance quarters it.
+I3  the cost of accuracy in the charged gas: charged-gas over I1's time at tolerances from 6e-3
+    down to the default, each with its cost against the fixed step timed in the same run (the
+    target: max |dE/E| <= 1e-5 over 60 s at no more than 3x the fixed step's cost).
 
-Prints a table and writes ``benchmarks/results/integrator.json``.
+Prints a table and writes ``benchmarks/results/integrator.json`` (``--only I3`` runs one part).
 """
 
 from __future__ import annotations
@@ -77,13 +80,42 @@ def against_tolerance(seconds: float = 20.0) -> list[dict[str, object]]:
     return rows
 
 
+GAS_TOLERANCES = (6e-3, 3e-3, 1.5e-3, DEFAULT_TOLERANCE)
+
+
+def gas_cost(seconds: float) -> list[dict[str, object]]:
+    """I3: charged-gas's energy error and cost against the fixed step, by tolerance."""
+    cd.load("charged-gas", integrator="fixed").run(steps=2)  # compile
+    fixed, _ = timed_drift(cd.load("charged-gas", integrator="fixed"), seconds)
+    rows = []
+    for tolerance in GAS_TOLERANCES:
+        wall, error = timed_drift(cd.load("charged-gas", tolerance=tolerance), seconds)
+        rows.append({"scene": "charged-gas", "time": seconds, "tolerance": tolerance,
+                     "max_rel_drift": error, "wall_seconds": wall,
+                     "cost_ratio": wall / fixed})  # fmt: skip
+        print(
+            f"charged-gas {seconds:4g} s tolerance {tolerance:.1e}: {error:.2e} in "
+            f"{wall:.3g} s, cost x{wall / fixed:.3g} of the fixed step",
+            flush=True,
+        )
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--time", type=float, default=60.0, help="simulated seconds for I1")
+    parser.add_argument(
+        "--only", choices=("I1", "I2", "I3"), help="run one part (the others' results are kept)"
+    )
     args = parser.parse_args()
-    results = {"scenes": scenes(args.time), "tolerance": against_tolerance()}
+    parts = {"scenes": ("I1", scenes, (args.time,)), "tolerance": ("I2", against_tolerance, ()),
+             "gas_cost": ("I3", gas_cost, (args.time,))}  # fmt: skip
+    results = {key: run(*arguments) for key, (name, run, arguments) in parts.items()
+               if args.only in (None, name)}  # fmt: skip
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "integrator.json").write_text(json.dumps(results, indent=2))
+    path = RESULTS / "integrator.json"
+    kept = json.loads(path.read_text()) if path.exists() and args.only else {}
+    path.write_text(json.dumps(kept | results, indent=2))
 
 
 if __name__ == "__main__":
