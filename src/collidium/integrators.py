@@ -215,7 +215,7 @@ class AdaptiveLeapfrog(Integrator):
             )
         n = max(self.substeps, self.needed(rate2, dt))
         while True:
-            fastest = self._interval(particles, vessel, field, drift, now, dt, tally, n)
+            fastest = self._interval(particles, vessel, field, drift, now, dt, tally, n, rate2)
             required = self.needed(fastest, dt)
             if required <= n:
                 break
@@ -234,11 +234,12 @@ class AdaptiveLeapfrog(Integrator):
         dt: float,
         tally: Tally,
         n: int,
+        fastest: float,
     ) -> float:
         """Take the interval in ``n`` regular substeps (each split at contacts); returns the
         largest squared rate (1/s^2) met at their boundaries (the regular ones: they are the same
-        forwards and backwards, and contacts come with their own substep boundaries)."""
-        fastest = _squared_rate(particles, vessel, field)
+        forwards and backwards, and contacts come with their own substep boundaries), starting
+        from ``fastest``, the interval's start's (`_squared_rate`)."""
         t = now
         for s in range(1, n + 1):
             end = now + dt * s / n

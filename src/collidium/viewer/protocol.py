@@ -204,8 +204,7 @@ _MESSAGE: TypeAdapter[Message] = TypeAdapter(cast(Any, Message))
 MESSAGE_TYPES = (
     "ready", "ack", "play", "pause", "step", "reset", "export", "speed", "heat", "collisions",
     "charges", "momentum", "colour", "wall_temperature", "pump", "move_wall", "histogram_window",
-    "trace",
-    "set_velocity", "load", "scenario", "raw",
+    "trace", "set_velocity", "load", "scenario", "raw",
 )  # fmt: skip
 
 

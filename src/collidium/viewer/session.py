@@ -309,10 +309,10 @@ class ViewerSession:
 
     def set_colour(self, mode: ColourMode) -> None:
         """Colour the disks by ``mode``: "speed", "charge" or "species" (see `_colour_modes`)."""
-        if mode not in self._colour_modes():
-            offered = ", ".join(self._colour_modes())
+        offered = self._colour_modes()
+        if mode not in offered:
             raise InputError(
-                "mode", f"{mode!r} does not apply to this scene; choose from {offered}"
+                "mode", f"{mode!r} does not apply to this scene; choose from {', '.join(offered)}"
             )
         self.colour = mode
         self.version += 1  # the next frame carries velocities (or stops carrying them)
