@@ -106,6 +106,8 @@ NEGATIVE_MASS = '[[particles]]\nkind = "explicit"\nposition = [[0.0, 0.0]]\nmass
 OVERLAP = '[[particles]]\nkind = "explicit"\nposition = [[0.0, 0.0], [0.3, 0.0]]\n'
 OUTSIDE = '[[particles]]\nkind = "explicit"\nposition = [[0.0, 0.0], [12.0, 0.0]]\n'
 DT_ZERO = '[run]\ndt = 0.0\n[[particles]]\nkind = "random"\nn = 3\n'
+UNKNOWN_FORCE = '[[forces]]\ntype = "yukawa"\n[[particles]]\nkind = "random"\nn = 3\n'
+NEGATIVE_G = '[[forces]]\ntype = "newton"\nG = -1.0\n[[particles]]\nkind = "random"\nn = 3\n'
 PISTON_OUTSIDE = (
     '[vessel.walls.top]\nresponse = "piston"\nposition = 11.0\n'
     '[[particles]]\nkind = "random"\nn = 3\n'
@@ -129,6 +131,8 @@ PISTON_STEP = (
         (["run", "{file}"], EXTRA, "particles.0.colour"),
         (["run", "{file}"], NEGATIVE_MASS, "particles.0.mass"),
         (["run", "{file}"], DT_ZERO, "run.dt"),
+        (["run", "{file}"], UNKNOWN_FORCE, "forces.0.type"),
+        (["run", "{file}"], NEGATIVE_G, "forces.0.G"),
         (["run", "{file}"], OVERLAP, "particles.0.position.1"),
         (["run", "{file}"], OUTSIDE, "particles.0.position.1"),
         (["run", "{file}"], PISTON_OUTSIDE, "vessel.walls.top.position"),

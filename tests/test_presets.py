@@ -33,6 +33,8 @@ SECTIONS = {
     "granular": "5",
     "piston": "5",
     "effusion": "5",
+    "atmosphere": "5",
+    "projectile": "5",
 }
 
 # name -> (positions, velocities, masses, charges, radius, Coulomb (k, softening) or None)
@@ -84,7 +86,8 @@ def test_default_vessel_and_run(name):
     assert scenario.run.dt == 0.01
     assert scenario.run.collisions == "exact"
     times = {"pool-break": 60.0, "heat-flow": 60.0, "brownian": 300.0, "granular": 30.0,
-             "piston": 60.0, "effusion": 200.0, "hard-disks": 50.0}  # fmt: skip
+             "piston": 60.0, "effusion": 200.0, "hard-disks": 50.0, "atmosphere": 120.0,
+             "projectile": 5.0}  # fmt: skip
     assert scenario.run.time == times.get(name, 10.0)
     if name == "circle-gas":
         assert scenario.to_dict()["vessel"] == {"shape": "circle", "radius": 11.3}
@@ -106,7 +109,8 @@ def test_default_vessel_and_run(name):
         return
     assert scenario.vessel.boundary == "reflecting"
     size = {"pool-break": (40.0, 20.0), "heat-flow": (40.0, 10.0), "piston": (20.0, 40.0),
-            "effusion": (40.0, 20.0)}.get(name, (20.0, 20.0))  # fmt: skip
+            "effusion": (40.0, 20.0), "atmosphere": (40.0, 100.0)}  # fmt: skip
+    size = size.get(name, (20.0, 20.0))
     assert (scenario.vessel.width, scenario.vessel.height) == size
 
 
@@ -472,3 +476,19 @@ def test_hard_disks_follow_hendersons_equation_of_state():
     henderson = hard_disk_compressibility(0.3)
     z, error = thermo.compressibility(), thermo.compressibility_error()
     assert abs(z - henderson) < 3 * error + abs(henderson - series)
+
+
+def test_projectile_falls_on_the_parabola_and_lands_at_the_textbook_range():
+    """q E / m = 2 m/s^2 down, a drop of 9.75 m to the floor at 4 m/s: it lands after
+    sqrt(2 h m / (q E)) = 3.1225 s, 12.49 m on (`theory.projectile_range`)."""
+    sim = preset("projectile").build()
+    start = sim.particles.position[0].copy()
+    landing = theory.projectile_range(4.0, 9.75, 2.0) / 4.0
+    sim.run(time=3.12)  # just before the landing: still on the parabola, to round-off
+    t = sim.time
+    np.testing.assert_allclose(
+        sim.particles.position[0], start + np.array([4.0 * t, -t * t]), atol=1e-12
+    )
+    assert sim.counters.wall_hits["bottom"] == 0 and t < landing
+    sim.run(time=0.01)  # just after: one bounce on the floor
+    assert sim.counters.wall_hits["bottom"] == 1 and sim.time > landing

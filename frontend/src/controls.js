@@ -128,7 +128,7 @@ export function createControls(container, { send, report, temperature }) {
 
   // Display and physics toggles.
   const collisionsToggle = checkbox("toggle-collisions", "collisions");
-  const chargesToggle = checkbox("toggle-charges", "charges");
+  const forcesToggle = checkbox("toggle-forces", "forces");
   const momentumToggle = checkbox("toggle-momentum", "momentum vectors");
   const colourSelect = element("select", { id: "colour", title: "colour the disks by" });
 
@@ -165,7 +165,7 @@ export function createControls(container, { send, report, temperature }) {
     ]),
     element("div", { className: "control-group toggle-group" }, [
       collisionsToggle.label,
-      chargesToggle.label,
+      forcesToggle.label,
       momentumToggle.label,
       labelled("colour by", colourSelect),
       labelled("histogram", histogramSelect),
@@ -265,7 +265,7 @@ export function createControls(container, { send, report, temperature }) {
   heatButton.addEventListener("click", () => send({ type: "heat", factor: HEAT_FACTOR }));
   coolButton.addEventListener("click", () => send({ type: "heat", factor: COOL_FACTOR }));
   collisionsToggle.input.addEventListener("change", toggleSender(collisionsToggle.input, "collisions"));
-  chargesToggle.input.addEventListener("change", toggleSender(chargesToggle.input, "charges"));
+  forcesToggle.input.addEventListener("change", toggleSender(forcesToggle.input, "forces"));
   momentumToggle.input.addEventListener("change", toggleSender(momentumToggle.input, "momentum"));
   let holding = false;
   function hold(kind) {
@@ -323,12 +323,12 @@ export function createControls(container, { send, report, temperature }) {
       if (typeof limits.max_particles === "number") maxParticles = limits.max_particles;
       fillOverrides(null);
     },
-    /** Reflects the scene: its preset and overrides; charges can only be toggled if it has any. */
+    /** Reflects the scene: its preset and overrides; forces can only be toggled if it has any. */
     setScene(scene) {
       selectPreset(scene.preset ?? null);
       fillOverrides(scene.preset ?? null, scene.overrides ?? {});
-      chargesToggle.input.disabled = !scene.has_charges;
-      chargesToggle.label.classList.toggle("disabled", !scene.has_charges);
+      forcesToggle.input.disabled = !scene.has_forces;
+      forcesToggle.label.classList.toggle("disabled", !scene.has_forces);
       const modes = Array.isArray(scene.colour_modes) ? scene.colour_modes : ["speed"];
       colourSelect.replaceChildren(...modes.map((mode) => element("option", { value: mode, text: COLOUR_LABELS[mode] ?? mode })));
       colourSelect.disabled = modes.length < 2;
@@ -339,7 +339,7 @@ export function createControls(container, { send, report, temperature }) {
       playButton.textContent = playing ? "Pause" : "Play";
       stepButton.disabled = playing;
       collisionsToggle.input.checked = Boolean(status.collisions);
-      chargesToggle.input.checked = Boolean(status.charges);
+      forcesToggle.input.checked = Boolean(status.forces);
       momentumToggle.input.checked = Boolean(status.momentum);
       if (typeof status.colour === "string") colourSelect.value = status.colour;
       if (typeof status.histogram_window === "number") histogramSelect.value = String(status.histogram_window);

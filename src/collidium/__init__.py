@@ -1,4 +1,5 @@
-"""collidium: particles in a 2D vessel with exact elastic collisions and Coulomb forces.
+"""collidium: particles in a 2D vessel with exact elastic collisions, Coulomb forces, gravity
+and fields.
 
 >>> import collidium as cd
 >>> sim = cd.load("gas", n=500, seed=3)
@@ -9,7 +10,7 @@ from typing import Any
 
 from collidium import observers
 from collidium.errors import InputError, SimulationError
-from collidium.forces import Coulomb
+from collidium.forces import Coulomb, Gravity, Newton, UniformField
 from collidium.loading import load
 from collidium.presets import presets
 from collidium.simulation import Counters, Energy, Simulation, restore
@@ -22,12 +23,15 @@ __all__ = [
     "Coulomb",
     "Counters",
     "Energy",
+    "Gravity",
     "InputError",
+    "Newton",
     "Particles",
     "Partition",
     "Polygon",
     "Simulation",
     "SimulationError",
+    "UniformField",
     "load",
     "observers",
     "presets",

@@ -121,8 +121,9 @@ class Drift(Protocol):
         ``acceleration`` (N, 2), in m/s^2, is that of the step's half kicks when forces act; a mode
         may use it to time collisions within the step consistently with the kicks.
 
-        A mode with exact contact times stops at the first collision or wall hit after
-        ``halt_after`` (s) of a particle with a non-zero acceleration and returns it, leaving
+        A mode with exact contact times stops at the first wall hit of a particle with a
+        non-zero acceleration, or collision of two with different accelerations, after
+        ``halt_after`` (s) and returns it, leaving
         ``particles`` and ``tally`` part-way (the caller restores them); other modes, and every
         mode when nothing halts it, return None.
         """

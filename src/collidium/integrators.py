@@ -45,7 +45,9 @@ TOTAL_ENERGY_FLOOR = 10.0
 
 #: Contacts less than this fraction of ``dt`` after a substep starts are taken inside its drift:
 #: they are the ones a substep was shortened for, now at the very start of the drift, where the
-#: engine's kick-timing correction makes the response exact.
+#: engine's kick-timing correction makes the response exact; and those whose kick-drift-kick
+#: parabola meets them that soon (a disk resting on a floor under gravity), which shortened
+#: substeps would meet again and again without end.
 CONTACT_WINDOW = 1e-8
 
 #: A substep shortened for a contact ends this fraction of ``dt`` before it, so that the contact
@@ -260,21 +262,31 @@ class AdaptiveLeapfrog(Integrator):
         tally: Tally,
     ) -> float:
         """One kick-drift-kick from ``t`` to ``end`` (s), or to just before the first contact of
-        forced particles on the way; returns the time reached."""
+        forced particles on the way; returns the time reached.
+
+        A contact that the kick-drift-kick parabola puts within `CONTACT_WINDOW` of the start
+        (a disk resting on a floor under gravity, which a shortened substep would meet again
+        and again) is taken inside the drift, and the next one is looked for."""
         before = _Snapshot(particles, tally)
         h = end - t
         acceleration = field.acceleration
-        particles.velocity += (0.5 * h) * acceleration
-        contact = drift.drift(
-            particles, vessel, t, h, tally, acceleration, halt_after=t + CONTACT_WINDOW * dt
-        )
-        if contact is not None:
-            before.restore(particles, tally)
-            h = _shortened(particles, vessel, acceleration, contact, t, h, dt)
+        halt_after = t + CONTACT_WINDOW * dt
+        reached = end
+        while True:
             particles.velocity += (0.5 * h) * acceleration
-            drift.drift(particles, vessel, t, h, tally, acceleration)
+            contact = drift.drift(particles, vessel, t, h, tally, acceleration, halt_after)
+            if contact is None:
+                break
+            before.restore(particles, tally)
+            shortened = _shortened(particles, vessel, acceleration, contact, t, h, dt)
+            if shortened > CONTACT_WINDOW * dt:
+                h, reached = shortened, t + shortened
+                particles.velocity += (0.5 * h) * acceleration
+                drift.drift(particles, vessel, t, h, tally, acceleration)
+                break
+            halt_after = contact.time
         particles.velocity += (0.5 * h) * field.evaluate(particles, vessel)
-        return end if contact is None else t + h
+        return reached
 
 
 def _squared_rate(particles: Particles, vessel: Vessel, field: ForceField) -> float:

@@ -32,7 +32,8 @@ Particles = list[dict[str, Any]]
 #: Builds a preset's particle groups: positional parameters are shared settings it needs
 #: (``mass``, ``radius``...), keyword-only ones (with defaults) are the preset's own knobs. A
 #: preset that needs more returns a dict: ``particles``, and any of ``walls`` (the vessel's wall
-#: tables by name), ``partitions`` (the vessel's partition tables), ``run`` (run settings) and
+#: tables by name), ``partitions`` (the vessel's partition tables), ``run`` (run settings),
+#: ``forces`` (force tables besides the Coulomb force of a preset taking ``k``) and
 #: ``observers`` (observer tables).
 Builder = Callable[..., Particles | dict[str, Any]]
 AnyBuilder = TypeVar("AnyBuilder", bound=Builder)
@@ -123,6 +124,7 @@ def _scenario(name: str, values: dict[str, Any]) -> Scenario:
     forces = []
     if "k" in entry.parameters:
         forces.append({"type": "coulomb", "k": values["k"], "softening": values["softening"]})
+    forces.extend(parts.get("forces", []))
     return Scenario.from_dict(
         {
             "name": name,
@@ -509,6 +511,57 @@ def effusion(
         "particles": [light, heavy],
         "partitions": [divider],
         "observers": [{"kind": "effusion", "partition": "divider"}],
+    }
+
+
+@_preset(
+    "atmosphere",
+    "5",
+    "a gas under uniform gravity in a tall box: the density falls as exp(-m g y / kT)",
+    common=(*_NEUTRAL, "boundary"),
+    title="{n} disks under gravity g = {g:g} m/s^2: density as exp(-m g y / kT)",
+    radius=0.1,
+    width=40.0,
+    height=100.0,
+    time=120.0,
+)
+def atmosphere(
+    mass: float, radius: float, *, n: int = 2000, speed: float = 10.0, g: float = 1.0
+) -> dict[str, Any]:
+    """``n`` disks at random (velocity components uniform in ``[-speed, speed]`` m/s, kT about
+    ``m speed^2 / 3``) in a 40 m x 100 m box under uniform gravity ``g`` downwards. Collisions
+    share the energy between heights; in equilibrium the temperature is the same at every height
+    and, where the gas is dilute (the upper part), the density falls as the barometric law
+    ``exp(-m g y / kT)``, a scale height ``kT / (m g)`` of about 47 m at the defaults (the fall
+    heats the gas from kT = 33 J; `collidium.theory.barometric_density`). The disks are small
+    (radius 0.1 m, packing fraction below 0.03) so that the gas is nearly ideal: with radius
+    0.25 m the hard-disk pressure ``n kT (1 + 2 eta + ...)`` stretches the profile by a tenth
+    or more. The profile of density and temperature in 20 slices is measured from 40 s on."""
+    return {
+        "particles": gas(mass, radius, n=n, speed=speed),
+        "forces": [{"type": "gravity", "g": [0.0, -g]}],
+        "observers": [{"kind": "profile", "bins": 20, "axis": "y", "after": 40.0, "every": 10}],
+    }
+
+
+@_preset(
+    "projectile",
+    "5",
+    "a charge moving along a negatively charged bottom plate: a parabola (seed's future work)",
+    title="a +{charge:g} C charge at {speed:g} m/s over a plate pulling with E = {field:g} N/C",
+    time=5.0,
+)
+def projectile(
+    mass: float, radius: float, *, speed: float = 4.0, field: float = 2.0, charge: float = 1.0
+) -> dict[str, Any]:
+    """A charge ``charge`` (C) at (-8, 0) m moving at ``speed`` m/s along the x axis, above a
+    negatively charged bottom plate: a uniform field ``E = (0, -field)`` N/C. It falls on a
+    parabola and meets the floor (y = -10 m + radius) after ``t = sqrt(2 h m / (q E))``,
+    ``range = speed t`` further on (`collidium.theory.projectile_range`): 12.5 m at the
+    defaults; then it bounces."""
+    return {
+        "particles": [_pair([[-8.0, 0.0]], [[speed, 0.0]], mass, radius, charge)],
+        "forces": [{"type": "uniform_field", "E": [0.0, -field]}],
     }
 
 

@@ -62,6 +62,7 @@ validation problem becomes one `InputError` ``field.path: reason``.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 import os
 import stat
@@ -69,7 +70,7 @@ import tomllib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal, Union, get_origin
 
 import numpy as np
 import tomli_w
@@ -82,11 +83,13 @@ from pydantic import (
     Tag,
     ValidationError,
     ValidationInfo,
+    create_model,
     field_validator,
+    model_validator,
 )
 
 from collidium.errors import InputError
-from collidium.forces import DEFAULT_THETA, Coulomb
+from collidium.forces import FORCES, Force, parameters
 from collidium.initial import (
     CLOSE_PACKING,
     balanced_charges,
@@ -325,27 +328,66 @@ class RunSpec(_Model):
     restitution: Annotated[float, Field(gt=0, le=1)] = 1.0
 
 
-class CoulombSpec(_Model):
-    """Coulomb force (seed eq. 9-10): constant k, softening length, optional acceleration cap."""
+class _ForceSpec(_Model):
+    """A force's table: its ``type`` (a name in `collidium.forces.FORCES`) and parameters. The
+    models are made from the forces' own fields (`_force_spec`), which check their values."""
 
-    model_config = ConfigDict(extra="forbid", strict=True)
+    type: str
 
-    type: Literal["coulomb"] = "coulomb"
-    k: Finite = 5.0
-    softening: NonNegative = 0.0
-    max_acceleration: Positive | None = None
-    method: Literal["auto", "direct", "tree"] = "auto"
-    theta: Annotated[float, Field(gt=0.0, lt=1.0)] = DEFAULT_THETA
+    def build(self) -> Force:
+        """The force this describes."""
+        params = self.model_dump(exclude={"type"})
+        return FORCES[self.type](**params)
 
-    def build(self) -> Coulomb:
-        """The `Coulomb` force this describes."""
-        return Coulomb(
-            k=self.k, softening=self.softening, max_acceleration=self.max_acceleration,
-            method=self.method, theta=self.theta,
-        )  # fmt: skip
+    @model_validator(mode="after")
+    def _valid(self) -> _ForceSpec:
+        self.build()  # its InputError names the parameter (`_reason` puts it under the entry)
+        return self
 
 
-ForceSpec = Annotated[CoulombSpec, Field(discriminator="type")]
+def _schema_type(kind: Any) -> Any:
+    """The schema's type for a force parameter's annotation: floats finite, a 2D vector a list
+    of two (as TOML gives it), anything else (a Literal, None) as it is."""
+    if kind is float:
+        return Finite
+    if get_origin(kind) is tuple:
+        return Vector
+    if get_origin(kind) in (Union, type(int | None)):
+        return Union[tuple(_schema_type(arm) for arm in kind.__args__)]  # noqa: UP007
+    return kind
+
+
+def _plain(default: Any) -> Any:
+    """A default as the schema holds it: a vector as a list."""
+    return list(default) if isinstance(default, tuple) else default
+
+
+def _force_spec(name: str, cls: type) -> type[_ForceSpec]:
+    """The schema model of a registered force, from its parameters."""
+    fields: dict[str, Any] = {
+        key: (_schema_type(kind), ... if default is dataclasses.MISSING else _plain(default))
+        for key, (kind, default) in parameters(cls).items()
+    }
+    model: type[_ForceSpec] = create_model(
+        f"{cls.__name__}Spec", __base__=_ForceSpec, __doc__=cls.__doc__, __module__=__name__,
+        type=(Literal[name], name), **fields,
+    )  # fmt: skip
+    globals()[model.__name__] = model  # found by name, as pickle (a process pool) looks it up
+    return model
+
+
+#: The schema model of each force, by its ``type`` (made once, from the registry).
+_FORCE_SPECS: dict[str, type[_ForceSpec]] = {
+    name: _force_spec(name, cls) for name, cls in FORCES.items()
+}
+
+if TYPE_CHECKING:
+    ForceSpec = _ForceSpec
+else:  # one model per registered force, chosen by ``type``
+    ForceSpec = Annotated[
+        Union[tuple(Annotated[model, Tag(name)] for name, model in _FORCE_SPECS.items())],  # noqa: UP007
+        Discriminator("type"),
+    ]
 
 
 class _ObserverSpec(_Model):
@@ -702,7 +744,6 @@ _TAGGED: dict[str, type[_Model]] = {
     "random": RandomGroup,
     "rack": RackGroup,
     "lattice": LatticeGroup,
-    "coulomb": CoulombSpec,
     "energy": EnergySpec,
     "speeds": SpeedsSpec,
     "thermo": ThermoSpec,
@@ -711,6 +752,7 @@ _TAGGED: dict[str, type[_Model]] = {
     "tracer": TracerSpec,
     "effusion": EffusionSpec,
     "trajectory": TrajectorySpec,
+    **_FORCE_SPECS,
 }
 
 
@@ -727,8 +769,8 @@ class Scenario(_Model):
         The vessel, chosen by its ``shape``.
     run : RunSpec
         dt, default duration and collision mode.
-    forces : list of CoulombSpec
-        Forces between particles.
+    forces : list of force tables
+        The forces acting, each a ``type`` of `collidium.forces.FORCES` and its parameters.
     particles : list of ExplicitGroup, RandomGroup, RackGroup or LatticeGroup
         Particle groups, concatenated in order.
     observers : list of observer specs
@@ -1280,7 +1322,10 @@ def _reason(error: Any) -> tuple[str, str]:
     if kind == "finite_number":
         return path, f"must be a finite number, got {got}"
     if kind == "value_error":
-        return path, str(ctx.get("error", error["msg"]))
+        problem = ctx.get("error")
+        if isinstance(problem, InputError) and loc[:1] == ["forces"]:  # a force's own check
+            return f"{path}.{problem.field.rsplit('.', 1)[-1]}", problem.reason
+        return path, str(problem or error["msg"])
     message = error["msg"]
     message = message[0].lower() + message[1:]
     return path, f"{message}, got {got}" if "input" in error else message

@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike
 
 from collidium.collisions import COLLISION_MODES, CollisionMode, Tally, make_drift
 from collidium.errors import InputError, SimulationError
-from collidium.forces import Coulomb, ForceField
+from collidium.forces import Force, ForceField, force_from_dict
 from collidium.integrators import (
     DEFAULT_TOLERANCE,
     INTEGRATORS,
@@ -107,8 +107,9 @@ class Simulation:
         The vessel (`collidium.vessels`: a `Box`, a `Circle` or a `Polygon`).
     particles : Particles
         Initial state (the simulation keeps and updates this object).
-    forces : sequence of Coulomb, optional
-        Forces between particles; none for a free (hard-disk) gas.
+    forces : sequence of Force, optional
+        The forces acting (`collidium.forces`: `Coulomb`, `Newton`, `Gravity`, `UniformField`);
+        none for a free (hard-disk) gas.
     dt : float
         Time step in s (> 0), the interval between reports. Without forces and with exact
         collisions the motion is exact whatever its value; with forces the adaptive integrator
@@ -144,7 +145,7 @@ class Simulation:
         self,
         container: Vessel,
         particles: Particles,
-        forces: Sequence[Coulomb] = (),
+        forces: Sequence[Force] = (),
         dt: float = 0.01,
         collisions: CollisionMode = "exact",
         seed: int | None = None,
@@ -169,7 +170,7 @@ class Simulation:
         self,
         container: Vessel,
         particles: Particles,
-        forces: Sequence[Coulomb],
+        forces: Sequence[Force],
         dt: float,
         collisions: CollisionMode,
         seed: int | None,
@@ -295,13 +296,13 @@ class Simulation:
         self._integrator = make_integrator(self.integrator, value)
 
     @property
-    def forces(self) -> tuple[Coulomb, ...]:
+    def forces(self) -> tuple[Force, ...]:
         """The forces acting; may be replaced between runs (an empty sequence for none)."""
         return self._field.forces
 
     @forces.setter
-    def forces(self, forces: Sequence[Coulomb]) -> None:
-        _check_forces(forces, self.container)
+    def forces(self, forces: Sequence[Force]) -> None:
+        _check_forces(forces, self.container, self.particles)
         self._field = ForceField(tuple(forces))
 
     def add_particles(self, new: Particles) -> None:
@@ -593,7 +594,7 @@ def restore_with_meta(path: str | Path) -> tuple[Simulation, dict[str, Any]]:
             arrays["position"], arrays["velocity"], mass=arrays["mass"],
             radius=arrays["radius"], charge=arrays["charge"], image=arrays["image"],
         )  # fmt: skip
-        forces = [Coulomb(**{k: v for k, v in f.items() if k != "type"}) for f in state["forces"]]
+        forces = [force_from_dict(f, f"forces.{k}") for k, f in enumerate(state["forces"])]
         vessel = vessel_from_dict(saved_vessel(state))
         container = _check_setup(vessel, particles, forces, state["dt"], state["collisions"])
         sim = Simulation.__new__(Simulation)
@@ -655,7 +656,7 @@ def step_count(time: float | None, steps: int | None, dt: float) -> int:
 def _check_setup(
     container: Vessel,
     particles: Particles,
-    forces: Sequence[Coulomb],
+    forces: Sequence[Force],
     dt: float,
     collisions: str,
 ) -> Vessel:
@@ -666,7 +667,7 @@ def _check_setup(
         )
     if not isinstance(particles, Particles):
         raise InputError("particles", f"must be Particles, got {type(particles).__name__}")
-    _check_forces(forces, container)
+    _check_forces(forces, container, particles)
     _check_dt(dt)
     _check_mode(collisions, container)
     container.check_fits(particles.radius)
@@ -685,13 +686,13 @@ def _check_kinetic_energy(particles: Particles) -> None:
                                                f"component of {fastest:.3g} m/s)")  # fmt: skip
 
 
-def _check_forces(forces: Sequence[Coulomb], container: Vessel) -> None:
+def _check_forces(forces: Sequence[Force], container: Vessel, particles: Particles) -> None:
     if forces and container.piston is not None:
         raise InputError("forces", "a vessel with a piston holds a gas without forces")
     for k, force in enumerate(forces):
-        if not isinstance(force, Coulomb):
-            raise InputError(f"forces.{k}", f"unknown force {type(force).__name__}")
-        force.check_box(container)
+        if not isinstance(force, Force):
+            raise InputError(f"forces.{k}", f"not a force: {type(force).__name__}")
+        force.check(particles, container)
 
 
 def _check_integrator(integrator: str, tolerance: float) -> None:

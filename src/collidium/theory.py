@@ -1,6 +1,7 @@
 """Results from theory that measurements are compared with: the 2D Maxwell-Boltzmann speed
-distribution, the ideal gas and the hard-disk equation of state, Haff's cooling law and
-effusion. Boltzmann's constant is 1 (temperatures kT in J)."""
+distribution, the ideal gas and the hard-disk equation of state, Haff's cooling law, effusion,
+the barometric law and the range of a projectile. Boltzmann's constant is 1 (temperatures kT in
+J)."""
 
 from __future__ import annotations
 
@@ -150,3 +151,15 @@ def effusion_rate(normal_speed: float, width: float, area: float) -> float:
         Area of one chamber open to centres, m^2.
     """
     return normal_speed * width / (2.0 * area)
+
+
+def barometric_density(height: ArrayLike, mass: float, g: float, kT: float) -> FloatArray:
+    """The barometric law: the density of a dilute gas at ``height`` (m) relative to its density
+    at height 0, ``exp(-m g y / kT)``, under gravity ``g`` (m/s^2) at temperature kT (J)."""
+    return np.exp(-mass * g * np.asarray(height, dtype=float) / kT)
+
+
+def projectile_range(speed: float, drop: float, acceleration: float) -> float:
+    """How far (m) a body launched level at ``speed`` (m/s) travels while it falls ``drop`` m
+    under a constant ``acceleration`` (m/s^2): ``speed sqrt(2 drop / acceleration)``."""
+    return speed * math.sqrt(2.0 * drop / acceleration)

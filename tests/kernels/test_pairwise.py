@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from collidium.kernels import reference
-from collidium.kernels.pairwise import coulomb_direct, coulomb_stiffness
+from collidium.kernels.pairwise import inverse_distance_direct, inverse_distance_stiffness
 
 
 def _coulomb(position, charge, k=5.0, eps2=0.0, size=None):
@@ -17,7 +17,7 @@ def _coulomb(position, charge, k=5.0, eps2=0.0, size=None):
     virial = np.empty(n)
     periodic = size is not None
     w, h = size if periodic else (0.0, 0.0)
-    coulomb_direct(position, charge, k, eps2, w, h, periodic, force, energy, virial)
+    inverse_distance_direct(position, charge, k, eps2, w, h, periodic, force, energy, virial)
     return force, energy, virial
 
 
@@ -67,7 +67,7 @@ def test_kernel_equals_numpy_twin(charges, periodic):
     position, charge = charges
     size = np.array([16.0, 16.0]) if periodic else None
     got_force, got_energy, got_virial = _coulomb(position, charge, eps2=0.01, size=size)
-    want = reference.coulomb_direct(position, charge, 5.0, 0.01, size)
+    want = reference.inverse_distance_direct(position, charge, 5.0, 0.01, size)
     np.testing.assert_allclose(got_force, want[0], rtol=1e-12, atol=1e-13)
     np.testing.assert_allclose(got_energy, want[1], rtol=1e-12, atol=1e-13)
     np.testing.assert_allclose(got_virial, want[2], rtol=1e-12, atol=1e-13)
@@ -116,8 +116,10 @@ def test_stiffness_equals_numpy_twin(rng, n, periodic):
     charge[:2] = 1.0
     mass = rng.uniform(0.1, 2.0, n)
     size = np.array([16.0, 16.0]) if periodic else None
-    got = coulomb_stiffness(position, velocity, charge, mass, 5.0, 0.01, 16.0, 16.0, periodic)
-    want = reference.coulomb_stiffness(position, velocity, charge, mass, 5.0, 0.01, size)
+    got = inverse_distance_stiffness(
+        position, velocity, charge, mass, 5.0, 0.01, 16.0, 16.0, periodic
+    )
+    want = reference.inverse_distance_stiffness(position, velocity, charge, mass, 5.0, 0.01, size)
     assert got == pytest.approx(want, rel=1e-12)
 
 
@@ -126,7 +128,10 @@ def test_stiffness_of_a_pair_is_its_energy_times_its_squared_rate():
     position = np.array([[-1.0, 0.0], [1.0, 0.0]])
     velocity = np.array([[1.5, 0.0], [-1.5, 0.0]])
     charge, mass = np.array([1.0, -2.0]), np.array([1.0, 1.0])
-    got = coulomb_stiffness(position, velocity, charge, mass, 5.0, 0.0, 0.0, 0.0, False)
+    got = inverse_distance_stiffness(position, velocity, charge, mass, 5.0, 0.0, 0.0, 0.0, False)
     assert got == pytest.approx((5.0 * (9.0 + 10.0) / 4.0) ** 2, rel=1e-14)
     charge[1] = 0.0  # a neutral particle counts for nothing
-    assert coulomb_stiffness(position, velocity, charge, mass, 5.0, 0.0, 0.0, 0.0, False) == 0.0
+    assert (
+        inverse_distance_stiffness(position, velocity, charge, mass, 5.0, 0.0, 0.0, 0.0, False)
+        == 0.0
+    )

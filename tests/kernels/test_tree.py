@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from collidium.kernels import reference
-from collidium.kernels.pairwise import coulomb_direct
-from collidium.kernels.tree import LEAF_SIZE, THETA, coulomb_tree, tree_buffers
+from collidium.kernels.pairwise import inverse_distance_direct
+from collidium.kernels.tree import LEAF_SIZE, THETA, inverse_distance_tree, tree_buffers
 
 K = 5.0
 
@@ -21,14 +21,16 @@ def _tree(position, charge, eps2=0.0, theta=THETA, leaf_size=LEAF_SIZE, buffers=
     force, energy, virial = np.full((n, 2), np.nan), np.full(n, np.nan), np.full(n, np.nan)
     if buffers is None:
         buffers = tree_buffers(n, leaf_size)
-    coulomb_tree(position, charge, K, eps2, force, energy, virial, buffers, theta, leaf_size)
+    inverse_distance_tree(
+        position, charge, K, eps2, force, energy, virial, buffers, theta, leaf_size
+    )
     return force, energy, virial
 
 
 def _direct(position, charge, eps2=0.0):
     n = len(position)
     force, energy, virial = np.empty((n, 2)), np.empty(n), np.empty(n)
-    coulomb_direct(position, charge, K, eps2, 0.0, 0.0, False, force, energy, virial)
+    inverse_distance_direct(position, charge, K, eps2, 0.0, 0.0, False, force, energy, virial)
     return force, energy, virial
 
 
@@ -96,7 +98,7 @@ def test_kernel_equals_numpy_twin(rng, eps2, theta, leaf_size):
     position = rng.uniform(-8, 8, (n, 2))
     charge = rng.choice([-1.0, 1.0, 0.5, 0.0], n)
     got = _tree(position, charge, eps2, theta, leaf_size)
-    want = reference.coulomb_tree(position, charge, K, eps2, theta, leaf_size)
+    want = reference.inverse_distance_tree(position, charge, K, eps2, theta, leaf_size)
     for g, w in zip(got, want, strict=True):
         np.testing.assert_allclose(g, w, rtol=0, atol=1e-13 * np.abs(w).max())
     # And the tree is really approximating here (not a disguised direct sum).

@@ -19,7 +19,7 @@ from collidium.viewer import protocol
         {"type": "play"},
         {"type": "speed", "value": 2},
         {"type": "heat", "factor": 0.8},
-        {"type": "charges", "enabled": False},
+        {"type": "forces", "enabled": False},
         {"type": "trace", "index": None},
         {"type": "set_velocity", "index": 4, "vx": 1.5, "vy": -2},
         {"type": "load", "preset": "gas", "overrides": {"n": 300, "collisions": "step"}},

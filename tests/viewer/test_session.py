@@ -87,20 +87,20 @@ def test_frames_carry_the_piston_and_its_collisions_stay_on():
     assert session.sim.collisions == "exact"
 
 
-def test_charges_switch_the_forces_off_and_on():
+def test_the_forces_switch_off_and_on():
     session = ViewerSession(preset("charged-gas", n=50))
-    assert session.scene()["has_charges"]
+    assert session.scene()["has_forces"]
     potential = session.sim.energy().potential
-    session.enable_charges(False)
+    session.enable_forces(False)
     assert session.sim.forces == () and session.sim.energy().potential == 0.0
-    session.enable_charges(True)
+    session.enable_forces(True)
     assert session.sim.energy().potential == potential
 
 
-def test_charges_cannot_be_switched_on_without_forces(gas):
-    assert not gas.scene()["has_charges"]
-    with pytest.raises(InputError, match="charges: this scenario has no forces"):
-        gas.enable_charges(True)
+def test_forces_cannot_be_switched_on_without_any(gas):
+    assert not gas.scene()["has_forces"]
+    with pytest.raises(InputError, match="forces: this scenario has no forces"):
+        gas.enable_forces(True)
 
 
 def test_set_velocity_and_trace_check_the_index(gas):

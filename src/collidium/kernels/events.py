@@ -619,8 +619,9 @@ def run_events(
         Events between two re-sorts of the slots (`sort_slots`); the outcome does not depend on
         it, only the speed.
     halt : ndarray of float64, shape (4,)
-        ``halt[HALT_AFTER]`` (s): a pair collision or wall hit later than this time, of a
-        particle with a non-zero ``acceleration``, stops the drift before it is processed; its
+        ``halt[HALT_AFTER]`` (s): a wall hit later than this time of a particle with a non-zero
+        ``acceleration``, or a collision of two with different ones (`_halts`), stops the drift
+        before it is processed; its
         time and particles go to ``halt[HALT_TIME]``, ``halt[HALT_PARTICLE]`` and
         ``halt[HALT_PARTNER]`` (the partner, or ``-1 - contact`` for a contact with the vessel,
         `collidium.kernels.vessels.contacts`); ``halt[HALT_TIME]`` is NaN if
@@ -761,7 +762,10 @@ def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count,
 @_engine(inline="always")
 def _halts(k, t, body, ident, count, event, acceleration, halt) -> bool:
     """Whether slot k's event at time t is a contact that halts the drift (see `run_events`):
-    a valid pair collision or a wall hit with a force on one of its particles. Records it."""
+    a wall hit of a particle with an acceleration, or a valid pair collision of two particles
+    with different accelerations. Records it. (Under the same acceleration, a uniform gravity,
+    a pair's relative motion is free flight: its contact time is exact and the response, taken
+    on velocities that differ from the true ones by the same kick, is exact as well.)"""
     if acceleration.shape[0] == 0:
         return False
     code = event[k, CODE]
@@ -774,9 +778,11 @@ def _halts(k, t, body, ident, count, event, acceleration, halt) -> bool:
     else:
         return False  # a cell crossing
     i = ident[k]
-    forced = acceleration[i, 0] != 0.0 or acceleration[i, 1] != 0.0
     if partner >= 0:
-        forced = forced or acceleration[partner, 0] != 0.0 or acceleration[partner, 1] != 0.0
+        forced = (acceleration[i, 0] != acceleration[partner, 0]
+                  or acceleration[i, 1] != acceleration[partner, 1])  # fmt: skip
+    else:
+        forced = acceleration[i, 0] != 0.0 or acceleration[i, 1] != 0.0
     if not forced:
         return False
     halt[HALT_TIME] = t

@@ -1,5 +1,10 @@
 """Direct pair sums over all particles: one pair loop, small per-force evaluators.
 
+The pair forces of `collidium.forces` have the same inverse-distance form, ``U_ij = c s_i s_j /
+sqrt(r^2 + eps^2)``, with a per-particle source strength ``s`` and a coupling ``c``: Coulomb's
+charges with ``c = k``, Newton's gravity the masses with ``c = -G``. The loop is written once and
+takes the source and the coupling (`inverse_distance_pair` is the evaluator).
+
 Each row i is summed by one thread, always in the same way, so results do not depend on the
 number of threads (bitwise reproducible). The row loops are vectorised: ``fastmath`` lets LLVM
 reassociate (partial sums in vector lanes, ``k q_i`` taken out of the loop) and fuse
@@ -22,15 +27,17 @@ _FASTMATH = {"reassoc", "contract"}
 
 
 @numba.njit(cache=True, inline="always")
-def coulomb_pair(r2: float, kqq: float, softening2: float) -> tuple[float, float]:
-    """Coulomb evaluator (seed eq. 9-10, softened), with one square root and one division.
+def inverse_distance_pair(r2: float, kqq: float, softening2: float) -> tuple[float, float]:
+    """Softened inverse-distance evaluator (Coulomb, seed eq. 9-10; Newton's gravity), with one
+    square root and one division.
 
     Parameters
     ----------
     r2 : float
         Squared distance in m^2.
     kqq : float
-        Coulomb constant times the product of the charges, ``k q_i q_j``, in N m^2.
+        The coupling times the product of the sources: ``k q_i q_j`` (Coulomb) or
+        ``-G m_i m_j`` (gravity), in N m^2.
     softening2 : float
         Squared softening length in m^2.
 
@@ -65,7 +72,7 @@ def _row(
         dx = xi - x[j]
         dy = yi - y[j]
         r2 = dx * dx + dy * dy
-        f, uij = coulomb_pair(r2, kqi * q[j], softening2)
+        f, uij = inverse_distance_pair(r2, kqi * q[j], softening2)
         fx += f * dx
         fy += f * dy
         u += uij
@@ -98,7 +105,7 @@ def _row_periodic(
         dx -= width * round(dx / width)
         dy -= height * round(dy / height)
         r2 = dx * dx + dy * dy
-        f, uij = coulomb_pair(r2, kqi * q[j], softening2)
+        f, uij = inverse_distance_pair(r2, kqi * q[j], softening2)
         fx += f * dx
         fy += f * dy
         u += uij
@@ -107,10 +114,10 @@ def _row_periodic(
 
 
 @numba.njit(cache=True, parallel=True)
-def coulomb_direct(
+def inverse_distance_direct(
     position: np.ndarray,
-    charge: np.ndarray,
-    k: float,
+    source: np.ndarray,
+    coupling: float,
     softening2: float,
     width: float,
     height: float,
@@ -119,20 +126,21 @@ def coulomb_direct(
     energy: np.ndarray,
     virial: np.ndarray,
 ) -> None:
-    """Coulomb forces and per-particle energies by direct summation, O(N^2), parallel over rows.
+    """Inverse-distance forces and per-particle energies by direct summation, O(N^2), parallel
+    over rows: ``F_i = c s_i sum_j s_j r_ij / (r^2 + eps^2)^(3/2)``.
 
-    Only charged particles enter the sums (a neutral one feels and exerts no force), read from
-    contiguous copies of their coordinates and charges. Each row is summed over ``j < i`` then
-    ``j > i``, with no branch in the loops, which LLVM vectorises.
+    Only particles with a source enter the sums (a neutral one feels and exerts no Coulomb
+    force), read from contiguous copies of their coordinates and sources. Each row is summed
+    over ``j < i`` then ``j > i``, with no branch in the loops, which LLVM vectorises.
 
     Parameters
     ----------
     position : ndarray, shape (N, 2)
         Centres in m.
-    charge : ndarray, shape (N,)
-        Charges in C.
-    k : float
-        Coulomb constant in N m^2 / C^2.
+    source : ndarray, shape (N,)
+        Source strengths: charges in C (Coulomb) or masses in kg (gravity).
+    coupling : float
+        ``k`` in N m^2 / C^2 (Coulomb) or ``-G`` in N m^2 / kg^2 (gravity).
     softening2 : float
         Squared softening length in m^2.
     width, height : float
@@ -147,7 +155,7 @@ def coulomb_direct(
         Output: half of ``sum_j r_ij . F_ij`` for each particle, J (sum = the pair virial).
     """
     n = position.shape[0]
-    # Charged particles only, as contiguous x, y, q (work arrays of O(N) for O(N^2) work).
+    # Particles with a source only, as contiguous x, y, q (work arrays of O(N) for O(N^2) work).
     x = np.empty(n)
     y = np.empty(n)
     q = np.empty(n)
@@ -158,14 +166,14 @@ def coulomb_direct(
         force[i, 1] = 0.0
         energy[i] = 0.0
         virial[i] = 0.0
-        if charge[i] != 0.0:
+        if source[i] != 0.0:
             x[m] = position[i, 0]
             y[m] = position[i, 1]
-            q[m] = charge[i]
+            q[m] = source[i]
             index[m] = i
             m += 1
     for c in numba.prange(m):
-        xi, yi, kqi = x[c], y[c], k * q[c]
+        xi, yi, kqi = x[c], y[c], coupling * q[c]
         if periodic:
             below = _row_periodic(0, c, xi, yi, kqi, x, y, q, softening2, width, height)
             above = _row_periodic(c + 1, m, xi, yi, kqi, x, y, q, softening2, width, height)
@@ -188,14 +196,14 @@ def _stiffness_row(
     vy: np.ndarray,
     q: np.ndarray,
     inverse_mass: np.ndarray,
-    k: float,
+    coupling: float,
     softening2: float,
     width: float,
     height: float,
     periodic: bool,
 ) -> float:
     """Largest ``(|U_ij| rate_ij^2)^2`` of row c against the rows after it
-    (`coulomb_stiffness`)."""
+    (`inverse_distance_stiffness`)."""
     stiffness = 0.0
     for j in range(c + 1, x.shape[0]):
         dx = x[c] - x[j]
@@ -206,45 +214,46 @@ def _stiffness_row(
         inverse = 1.0 / math.sqrt(dx * dx + dy * dy + softening2)  # one division a pair
         dvx = vx[c] - vx[j]
         dvy = vy[c] - vy[j]
-        u = k * abs(q[c] * q[j]) * inverse
+        u = abs(coupling * q[c] * q[j]) * inverse
         w2 = dvx * dvx + dvy * dvy
         error = u * (w2 + u * (inverse_mass[c] + inverse_mass[j])) * inverse * inverse
         stiffness = max(stiffness, error * error)
     return stiffness
 
 
-#: Charged particles from which `coulomb_stiffness` runs its rows in parallel (below, starting
-#: the threads costs more than the rows).
+#: Particles with a source from which `inverse_distance_stiffness` runs its rows in parallel
+#: (below, starting the threads costs more than the rows).
 PARALLEL_STIFFNESS_FROM = 256
 
 
 @numba.njit(cache=True, parallel=True)
-def _stiffness_parallel(x, y, vx, vy, q, inverse_mass, k, softening2, width, height, periodic):
+def _stiffness_parallel(x, y, vx, vy, q, inverse_mass, coupling, softening2, width, height,
+                        periodic):  # fmt: skip
     m = x.shape[0]
     rows = np.zeros(m)
     for c in numba.prange(m):
         rows[c] = _stiffness_row(
-            c, x, y, vx, vy, q, inverse_mass, k, softening2, width, height, periodic
+            c, x, y, vx, vy, q, inverse_mass, coupling, softening2, width, height, periodic
         )
     return rows.max() if m else 0.0
 
 
 @numba.njit(cache=True)
-def coulomb_stiffness(
+def inverse_distance_stiffness(
     position: np.ndarray,
     velocity: np.ndarray,
-    charge: np.ndarray,
+    source: np.ndarray,
     mass: np.ndarray,
-    k: float,
+    coupling: float,
     softening2: float,
     width: float,
     height: float,
     periodic: bool,
 ) -> float:
-    """How fast the Coulomb pair energies change, for the adaptive integrator's substeps.
+    """How fast the inverse-distance pair energies change, for the adaptive integrator's substeps.
 
-    For each pair of charged particles, with ``s^2 = r^2 + eps^2`` (minimum image when
-    ``periodic``), ``|U_ij| = k |q_i q_j| / s`` and the squared rate
+    For each pair of particles with sources, with ``s^2 = r^2 + eps^2`` (minimum image when
+    ``periodic``), ``|U_ij| = |c q_i q_j| / s`` and the squared rate
     ``rate_ij^2 = (|v_i - v_j|^2 + |U_ij| (1/m_i + 1/m_j)) / s^2``: fly-by plus free fall, the
     inverse square of the time in which the pair's force turns or grows appreciably. A leapfrog
     step h errs on the pair's energy by about ``|U_ij| rate_ij^2 h^2``: the result is the largest
@@ -255,10 +264,10 @@ def coulomb_stiffness(
     ----------
     position, velocity : ndarray, shape (N, 2)
         In m and m/s.
-    charge, mass : ndarray, shape (N,)
-        In C and kg.
-    k : float
-        Coulomb constant in N m^2 / C^2.
+    source, mass : ndarray, shape (N,)
+        Source strengths (C or kg, `inverse_distance_direct`) and masses in kg.
+    coupling : float
+        ``k`` or ``-G`` (`inverse_distance_direct`).
     softening2 : float
         Squared softening length in m^2.
     width, height : float
@@ -270,29 +279,29 @@ def coulomb_stiffness(
     -------
     float
         The largest ``(|U_ij| rate_ij^2)^2`` over pairs, in J^2/s^4 (0 with fewer than two
-        charges).
+        sources).
     """
     n = position.shape[0]
     m = 0
     for i in range(n):
-        if charge[i] != 0.0:
+        if source[i] != 0.0:
             m += 1
     x, y = np.empty(m), np.empty(m)
     vx, vy = np.empty(m), np.empty(m)
     q, inverse_mass = np.empty(m), np.empty(m)
     c = 0
     for i in range(n):
-        if charge[i] != 0.0:
+        if source[i] != 0.0:
             x[c], y[c] = position[i, 0], position[i, 1]
             vx[c], vy[c] = velocity[i, 0], velocity[i, 1]
-            q[c], inverse_mass[c] = charge[i], 1.0 / mass[i]
+            q[c], inverse_mass[c] = source[i], 1.0 / mass[i]
             c += 1
     if m >= PARALLEL_STIFFNESS_FROM:
-        return _stiffness_parallel(x, y, vx, vy, q, inverse_mass, k, softening2, width, height,
-                                   periodic)  # fmt: skip
+        return _stiffness_parallel(x, y, vx, vy, q, inverse_mass, coupling, softening2, width,
+                                   height, periodic)  # fmt: skip
     stiffness = 0.0
     for c in range(m):
-        row = _stiffness_row(c, x, y, vx, vy, q, inverse_mass, k, softening2, width, height,
+        row = _stiffness_row(c, x, y, vx, vy, q, inverse_mass, coupling, softening2, width, height,
                              periodic)  # fmt: skip
         stiffness = max(stiffness, row)
     return stiffness

@@ -44,14 +44,15 @@ def fold(x: float, v: float, lo: float, hi: float) -> tuple[float, float, int]:
     return x, v, bounces
 
 
-def coulomb_direct(
+def inverse_distance_direct(
     position: FloatArray,
     charge: FloatArray,
     k: float,
     softening2: float,
     size: FloatArray | None = None,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Coulomb forces (N, 2), per-particle half pair energies (N,) and half pair virials
+    """Inverse-distance forces (N, 2) of sources ``charge`` (N,) with coupling ``k`` (Coulomb, or
+    masses and ``-G``), per-particle half pair energies (N,) and half pair virials
     ``r_ij . F_ij`` (N,) over all pairs at once. ``size`` (the box sides) turns on the minimum
     image.
     """
@@ -68,11 +69,11 @@ def coulomb_direct(
     return force, 0.5 * np.sum(k * qq * inv, axis=1), virial
 
 
-def coulomb_direct_on(
+def inverse_distance_on(
     position: FloatArray, charge: FloatArray, k: float, softening2: float, targets: IntArray
 ) -> FloatArray:
-    """Coulomb forces (M, 2) in N on the particles ``targets`` (M,) from all others, one target
-    at a time (O(M N) time, O(N) memory: for checking large systems on a sample)."""
+    """Inverse-distance forces (M, 2) in N on the particles ``targets`` (M,) from all others,
+    one target at a time (O(M N) time, O(N) memory: for checking large systems on a sample)."""
     force = np.empty((len(targets), 2))
     for row, i in enumerate(targets):
         d = position[i] - position
@@ -82,7 +83,7 @@ def coulomb_direct_on(
     return force
 
 
-def coulomb_stiffness(
+def inverse_distance_stiffness(
     position: FloatArray,
     velocity: FloatArray,
     charge: FloatArray,
@@ -92,7 +93,7 @@ def coulomb_stiffness(
     size: FloatArray | None = None,
 ) -> float:
     """The largest ``(|U_ij| rate_ij^2)^2`` (J^2/s^4) over charged pairs, all pairs at once, with
-    ``|U_ij| = k |q_i q_j| / s``, ``rate_ij^2 = (|v_ij|^2 + |U_ij| (1/m_i + 1/m_j)) / s^2`` and
+    ``|U_ij| = |k q_i q_j| / s``, ``rate_ij^2 = (|v_ij|^2 + |U_ij| (1/m_i + 1/m_j)) / s^2`` and
     ``s^2 = r^2 + eps^2``. ``size`` (the box sides) turns on the minimum image."""
     charged = charge != 0.0
     x, v, q, m = position[charged], velocity[charged], charge[charged], mass[charged]
@@ -102,7 +103,7 @@ def coulomb_stiffness(
     s2 = np.einsum("ijk,ijk->ij", d, d) + softening2
     np.fill_diagonal(s2, np.inf)  # no pair: U = 0 there
     w = v[:, None, :] - v[None, :, :]
-    u = k * np.abs(q[:, None] * q[None, :]) / np.sqrt(s2)
+    u = np.abs(k * q[:, None] * q[None, :]) / np.sqrt(s2)
     error = u * (np.einsum("ijk,ijk->ij", w, w) + u * (1 / m[:, None] + 1 / m[None, :])) / s2
     return float(np.max(error[np.triu_indices(q.size, 1)] ** 2, initial=0.0))
 
@@ -498,7 +499,7 @@ def _winds_around(point: FloatArray, edges: FloatArray) -> bool:
     return bool(abs(angles.sum()) > math.pi)
 
 
-def coulomb_tree(
+def inverse_distance_tree(
     position: FloatArray,
     charge: FloatArray,
     k: float,
@@ -506,8 +507,8 @@ def coulomb_tree(
     theta: float,
     leaf_size: int,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Twin of `tree.coulomb_tree`: forces (N, 2), half pair energies (N,) and half pair virials
-    (N,) by the same Barnes-Hut quadtree (same Morton cells, leaves, node radii and opening
+    """Twin of `tree.inverse_distance_tree`: forces (N, 2), half pair energies (N,) and half pair
+    virials (N,) by the same Barnes-Hut quadtree (same Morton cells, leaves, node radii and opening
     test), with each accepted node's order-4 Taylor expansion written out from its particles:
     ``sum_n sum_k (-1)^n / (2^k k! (n-2k)!) D_(n-k)(R) sum_j q_j |d_j|^2k (d_j . R)^(n-2k)``,
     ``D_m = 2^m g^(m)`` for the kernel g of each output."""

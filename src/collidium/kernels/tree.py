@@ -1,8 +1,10 @@
-"""Barnes-Hut quadtree for the softened Coulomb force, with order-4 multipoles, walked per leaf.
+"""Barnes-Hut quadtree for the softened inverse-distance forces, with order-4 multipoles, walked
+per leaf.
 
-Physics as `pairwise.coulomb_direct` (open box only): ``F_i = k q_i sum_j q_j r_ij /
+Physics as `pairwise.inverse_distance_direct` (open box only): ``F_i = k q_i sum_j q_j r_ij /
 (r^2+eps^2)^(3/2)``, energy and virial per particle = half the pair sums of
-``k q_i q_j / sqrt(r^2+eps^2)`` and ``r_ij . F_ij``.
+``k q_i q_j / sqrt(r^2+eps^2)`` and ``r_ij . F_ij``. Written for Coulomb's charges q and
+constant k, it sums Newton's gravity as well, with the masses as q and ``-G`` as k.
 
 Tree. Particles are sorted by the Morton (Z-order) code of their cell on a 2^21 x 2^21 grid over
 the bounding square (LSD radix sort, ties by index: unique). Each node is the smallest quadtree
@@ -55,11 +57,12 @@ The default THETA = 0.3 keeps the error below 1e-3 with a margin of 3 in the wor
 and 20 typically; with eps larger than the interparticle spacing (forces then collective
 and weak) errors are 5 to 7 times the eps = 0 ones. Two threads take 0.31, 0.40 and 0.59
 us/particle at N = 1e4, 1e5 and 1e6 (one thread: 0.58, 0.76, 1.12). The tree beats
-`coulomb_direct` (2 threads) from about N = 200 (0.15 against 0.23 us/particle at N = 500, 0.21
-against 0.85 at N = 2000).
+`inverse_distance_direct` (2 threads) from about N = 200 (0.15 against 0.23 us/particle at
+N = 500, 0.21 against 0.85 at N = 2000).
 
-Use: ``buffers = tree_buffers(n)`` once, then ``coulomb_tree(position, charge, k, eps**2, force,
-energy, virial, buffers)`` each step; or the kernels `build_tree` and `evaluate_tree` directly.
+Use: ``buffers = tree_buffers(n)`` once, then ``inverse_distance_tree(position, charge, k,
+eps**2, force, energy, virial, buffers)`` each step; or the kernels `build_tree` and
+`evaluate_tree` directly.
 Not for periodic boxes (no images).
 """
 
@@ -70,7 +73,7 @@ import math
 import numba
 import numpy as np
 
-from collidium.kernels.pairwise import coulomb_pair
+from collidium.kernels.pairwise import inverse_distance_pair
 from collidium.kernels.sorting import radix_sort
 
 THETA = 0.3
@@ -530,7 +533,7 @@ def _near_sum(
         dy = y - sy[j]
         r2 = dx * dx + dy * dy
         itself = source_index[j] == target  # skipped with a zero charge at a harmless distance
-        f, u = coulomb_pair(1.0 if itself else r2, 0.0 if itself else sq[j], softening2)
+        f, u = inverse_distance_pair(1.0 if itself else r2, 0.0 if itself else sq[j], softening2)
         ex += f * dx
         ey += f * dy
         phi += u
@@ -903,10 +906,10 @@ def _node_arrays(capacity: int) -> dict[str, np.ndarray]:
 
 
 def tree_buffers(n: int, leaf_size: int = LEAF_SIZE) -> dict[str, np.ndarray]:
-    """Work arrays for `coulomb_tree` with ``n`` particles, to allocate once and keep.
+    """Work arrays for `inverse_distance_tree` with ``n`` particles, to allocate once and keep.
 
     The node arrays start at a capacity that fits uniform and moderately clustered systems;
-    `coulomb_tree` doubles them in place in the dict if a tree ever needs more (at most
+    `inverse_distance_tree` doubles them in place in the dict if a tree ever needs more (at most
     ``2 n - 1`` nodes).
 
     Returns
@@ -921,10 +924,10 @@ def tree_buffers(n: int, leaf_size: int = LEAF_SIZE) -> dict[str, np.ndarray]:
     return arrays
 
 
-def coulomb_tree(
+def inverse_distance_tree(
     position: np.ndarray,
-    charge: np.ndarray,
-    k: float,
+    source: np.ndarray,
+    coupling: float,
     softening2: float,
     force: np.ndarray,
     energy: np.ndarray,
@@ -933,11 +936,11 @@ def coulomb_tree(
     theta: float = THETA,
     leaf_size: int = LEAF_SIZE,
 ) -> None:
-    """Coulomb forces, per-particle energies and virials by Barnes-Hut tree, O(N log N).
+    """Inverse-distance forces, per-particle energies and virials by Barnes-Hut tree, O(N log N).
 
-    Same physics, outputs and units as `pairwise.coulomb_direct` without the periodic box:
-    ``F_i = k q_i sum_j q_j r_ij / (r^2 + eps^2)^(3/2)``, energy = half of
-    ``k q_i sum_j q_j / sqrt(r^2 + eps^2)``, virial = half of ``sum_j r_ij . F_ij``; pairs closer
+    Same physics, outputs and units as `pairwise.inverse_distance_direct` without the periodic
+    box: ``F_i = c s_i sum_j s_j r_ij / (r^2 + eps^2)^(3/2)``, energy = half of
+    ``c s_i sum_j s_j / sqrt(r^2 + eps^2)``, virial = half of ``sum_j r_ij . F_ij``; pairs closer
     than the tree's opening criterion are summed exactly, farther ones through order-4
     multipole expansions. Results do not depend on the number of threads (bitwise).
 
@@ -945,10 +948,10 @@ def coulomb_tree(
     ----------
     position : ndarray, shape (N, 2)
         Centres in m.
-    charge : ndarray, shape (N,)
-        Charges in C.
-    k : float
-        Coulomb constant in N m^2 / C^2.
+    source : ndarray, shape (N,)
+        Source strengths: charges in C (Coulomb) or masses in kg (gravity).
+    coupling : float
+        ``k`` in N m^2 / C^2 (Coulomb) or ``-G`` in N m^2 / kg^2 (gravity).
     softening2 : float
         Squared softening length in m^2.
     force : ndarray, shape (N, 2)
@@ -973,7 +976,7 @@ def coulomb_tree(
     b = buffers
     while True:
         nodes, n_leaves = build_tree(
-            position, charge, leaf_size, b["code"], b["key"], b["key_spare"], b["order"],
+            position, source, leaf_size, b["code"], b["key"], b["key_spare"], b["order"],
             b["order_spare"], b["sorted_x"], b["sorted_y"], b["sorted_q"], b["node_index"],
             b["node_geometry"], b["node_raw"], b["node_coef"], b["leaves"], b["depth_start"],
         )  # fmt: skip
@@ -984,7 +987,7 @@ def coulomb_tree(
             raise RuntimeError("quadtree with more than 2 N - 1 nodes")  # cannot happen
         b.update(_node_arrays(min(2 * capacity, 2 * n - 1)))
     evaluate_tree(
-        k, softening2, theta, b["order"], b["sorted_x"], b["sorted_y"], b["sorted_q"],
+        coupling, softening2, theta, b["order"], b["sorted_x"], b["sorted_y"], b["sorted_q"],
         b["node_index"], b["node_geometry"], b["node_coef"], b["leaves"], n_leaves,
         force, energy, virial,
     )  # fmt: skip

@@ -1,5 +1,6 @@
-"""Temperature profile: kT in slices of the vessel along an axis, averaged over a run (heat flow
-between walls at different temperatures shows as a slope)."""
+"""Temperature and density profile: kT and disks per m^2 in slices of the vessel along an axis,
+averaged over a run (heat flow between walls at different temperatures shows as a slope of kT,
+gravity as a fall of the density)."""
 
 from __future__ import annotations
 
@@ -21,8 +22,8 @@ Axis = Literal["x", "y"]
 
 
 class TemperatureProfile(Measurement):
-    """kT = mean kinetic energy per disk (Boltzmann's constant 1, 2D) in ``bins`` equal slices of
-    the vessel's bounding box along ``axis``, pooled over the samples.
+    """kT = mean kinetic energy per disk (Boltzmann's constant 1, 2D) and the number density in
+    ``bins`` equal slices of the vessel's bounding box along ``axis``, pooled over the samples.
 
     Parameters
     ----------
@@ -49,11 +50,13 @@ class TemperatureProfile(Measurement):
         self._energy: list[np.ndarray] = []
         self._count: list[np.ndarray] = []
         self.edges = np.empty(0)
+        self._slice_area = np.nan
 
     def _start(self, sim: Simulation) -> None:
         d = 0 if self.axis == "x" else 1
         low, high = sim.container.bounds[:, d]
         self.edges = np.linspace(low, high, self.bins + 1)
+        self._slice_area = float(np.prod(sim.container.size)) / self.bins
         self._energy, self._count = [], []
 
     def _sample(self, sim: Simulation) -> None:
@@ -76,6 +79,22 @@ class TemperatureProfile(Measurement):
         count = np.sum(self._count, axis=0)
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.sum(self._energy, axis=0) / count
+
+    @property
+    def density(self) -> FloatArray:
+        """Mean number of disks per m^2 in each slice of the bounding box (a slice of a box is a
+        strip of the box), 1/m^2."""
+        return np.mean(self._count, axis=0) / self._slice_area
+
+    def density_error(self) -> FloatArray:
+        """Standard error of each slice's density, 1/m^2 (block averages; NaN with fewer than
+        3 samples)."""
+        if len(self._count) < 3:
+            return np.full(self.bins, np.nan)
+        count = np.asarray(self._count)
+        weights = np.ones(len(count))
+        errors = [_standard_error(_blocks(count[:, k], weights)[0]) for k in range(self.bins)]
+        return np.array(errors) / self._slice_area
 
     def temperature_error(self) -> FloatArray:
         """Standard error of each slice's kT, J (block averages; NaN with fewer than 3
@@ -102,10 +121,13 @@ class TemperatureProfile(Measurement):
         return ax
 
     def summary(self) -> dict[str, Any]:
-        """The profile: slice centres (m), kT and its error (J)."""
+        """The profile: slice centres (m), kT and its error (J), density and its error
+        (1/m^2)."""
         return {
             "axis": self.axis,
             "centres": self.centres.tolist(),
             "temperature": [float(t) for t in self.temperature],
             "temperature_error": [float(e) for e in self.temperature_error()],
+            "density": [float(d) for d in self.density],
+            "density_error": [float(e) for e in self.density_error()],
         }

@@ -174,8 +174,8 @@ class Connection:
                 s.set_velocity(index, vx, vy)
             case protocol.Toggle(type="collisions", enabled=enabled):
                 s.enable_collisions(enabled)
-            case protocol.Toggle(type="charges", enabled=enabled):
-                s.enable_charges(enabled)
+            case protocol.Toggle(type="forces", enabled=enabled):
+                s.enable_forces(enabled)
             case protocol.Toggle(type="momentum", enabled=enabled):
                 s.momentum = enabled
                 s.version += 1  # the next frame carries velocities

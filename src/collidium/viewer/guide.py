@@ -121,6 +121,16 @@ GUIDES: dict[str, Guide] = {
         "sqrt(m_heavy / m_light) (Graham's law).",
         colour="species",
     ),
+    "atmosphere": Guide(
+        "A gas under gravity in a tall box: the disks crowd at the bottom and thin out upwards, "
+        "the density halving every 0.69 kT / (m g) of height (the barometric law), while the "
+        "temperature is the same at every height."
+    ),
+    "projectile": Guide(
+        "A positive charge moves along a negatively charged plate: the field pulls it down with "
+        "a constant force, so it falls on a parabola, like a thrown ball, and bounces.",
+        colour="charge",
+    ),
 }
 
 #: Label and unit of the parameters the page offers, by name (unknown ones show their name).

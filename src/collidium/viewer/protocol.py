@@ -10,7 +10,7 @@ Front end to server (validated by `parse_message`; a bad one gets an ``error`` r
     play | pause | step | reset | export
     speed          value: float              simulated seconds per wall-clock second
     heat           factor: float             multiply the kinetic energy (cool: factor < 1)
-    collisions | charges | momentum          enabled: bool
+    collisions | forces | momentum           enabled: bool
     colour         mode: str                 colour the disks by "speed", "charge" or "species"
     wall_temperature  temperature: float | null  hold the walls at kT (J) (heat or cool
                                              continuously); null gives them back
@@ -130,7 +130,7 @@ class Heat(_Message):
 
 
 class Toggle(_Message):
-    type: Literal["collisions", "charges", "momentum"]
+    type: Literal["collisions", "forces", "momentum"]
     enabled: bool
 
 
@@ -203,7 +203,7 @@ _MESSAGE: TypeAdapter[Message] = TypeAdapter(cast(Any, Message))
 #: The ``type`` of each message the front end may send.
 MESSAGE_TYPES = (
     "ready", "ack", "play", "pause", "step", "reset", "export", "speed", "heat", "collisions",
-    "charges", "momentum", "colour", "wall_temperature", "pump", "move_wall", "histogram_window",
+    "forces", "momentum", "colour", "wall_temperature", "pump", "move_wall", "histogram_window",
     "trace", "set_velocity", "load", "scenario", "raw",
 )  # fmt: skip
 

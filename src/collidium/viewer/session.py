@@ -272,10 +272,10 @@ class ViewerSession:
         self.sim.collisions = self._mode if enabled else "off"
         self._changed()
 
-    def enable_charges(self, enabled: bool) -> None:
+    def enable_forces(self, enabled: bool) -> None:
         """The scenario's forces on or off."""
         if enabled and not self._forces:
-            raise InputError("charges", "this scenario has no forces to switch on")
+            raise InputError("forces", "this scenario has no forces to switch on")
         self.sim.forces = self._forces if enabled else ()
         self._changed()
 
@@ -303,7 +303,7 @@ class ViewerSession:
         return self.sim.collisions != "off"
 
     @property
-    def charges_enabled(self) -> bool:
+    def forces_enabled(self) -> bool:
         """Whether the scenario's forces act."""
         return bool(self.sim.forces)
 
@@ -437,7 +437,7 @@ class ViewerSession:
         (on a fresh installation it compiles the kernels, for up to half a minute)."""
         return {
             "type": "status", "playing": self.playing, "speed": self.speed,
-            "collisions": self.collisions_enabled, "charges": self.charges_enabled,
+            "collisions": self.collisions_enabled, "forces": self.forces_enabled,
             "momentum": self.momentum, "colour": self.colour,
             "wall_temperature": self.wall_temperature, "histogram_window": self.histogram_window,
             "has_walls": bool(self._vessel.shape_walls),

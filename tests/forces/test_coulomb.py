@@ -1,4 +1,4 @@
-"""Forces as physics objects: parameters, the seed's acceleration limiter, the force field."""
+"""Coulomb's force: parameters, the seed's acceleration limiter, direct and tree sums."""
 
 from __future__ import annotations
 
@@ -7,19 +7,25 @@ import pytest
 
 from collidium import Box, Coulomb, InputError, Particles, Simulation
 from collidium.forces import TREE_CROSSOVER, ForceField
+from collidium.forces.pair import uses_tree
 
 
 def test_limiter_caps_smoothly_and_leaves_small_accelerations_alone():
+    """Pairs at 0.01 m, 1 m and 30 m: accelerations of order 1e5, 5 and 5e-3 m/s^2 against a
+    cap of 10; each capped as ``a / sqrt(1 + (|a| / cap)^2)``, direction kept."""
     cap = 10.0
-    acceleration = np.array([[0.01, 0.0], [3.0, 4.0], [1e6, -1e6]])
-    limited = acceleration.copy()
-    Coulomb(max_acceleration=cap).limit(limited)
-    magnitude = np.linalg.norm(limited, axis=1)
+    position = [[-1e3, 0.0], [-1e3 + 0.01, 0.0], [0.0, 0.0], [0.6, 0.8], [400.0, 0.0], [430, 0.0]]
+    particles = Particles(position, charge=[1.0, -1.0] * 3)
+    box = Box(2000, 2000)
+    free = ForceField((Coulomb(k=5.0, method="direct"),)).evaluate(particles, box).copy()
+    limited = ForceField((Coulomb(k=5.0, method="direct", max_acceleration=cap),))
+    capped = limited.evaluate(particles, box)
+    pull = np.linalg.norm(free, axis=1)
+    np.testing.assert_allclose(capped, free / np.sqrt(1 + (pull / cap) ** 2)[:, None], rtol=1e-14)
+    magnitude = np.linalg.norm(capped, axis=1)
     assert (magnitude < cap).all()
-    assert limited[0, 0] == pytest.approx(0.01, rel=1e-6)  # |a| << cap: unchanged to (a/cap)^2
-    assert magnitude[2] == pytest.approx(cap, rel=1e-10)  # |a| >> cap: saturates at the cap
-    # Direction is kept.
-    np.testing.assert_allclose(limited[1] / magnitude[1], [0.6, 0.8])
+    assert magnitude[0] == pytest.approx(cap, rel=1e-7)  # |a| = 5e4: cap (1 - (cap / a)^2 / 2)
+    assert magnitude[4] == pytest.approx(pull[4], rel=1e-6)  # |a| << cap: unchanged
 
 
 def test_field_gives_acceleration_and_potential_of_a_pair():
@@ -65,12 +71,11 @@ def _plasma(n: int, seed: int = 3) -> Particles:
 
 
 def test_auto_sums_by_tree_from_the_crossover_and_never_in_a_periodic_box():
-    coulomb = Coulomb()
-    assert not coulomb.uses_tree(_plasma(TREE_CROSSOVER - 1), Box(10, 10))
-    assert coulomb.uses_tree(_plasma(TREE_CROSSOVER), Box(10, 10))
-    assert not coulomb.uses_tree(_plasma(TREE_CROSSOVER), Box(10, 10, "periodic"))
-    assert Coulomb(method="tree").uses_tree(_plasma(10), Box(10, 10))
-    assert not Coulomb(method="direct").uses_tree(_plasma(TREE_CROSSOVER), Box(10, 10))
+    assert not uses_tree("auto", _plasma(TREE_CROSSOVER - 1), Box(10, 10))
+    assert uses_tree("auto", _plasma(TREE_CROSSOVER), Box(10, 10))
+    assert not uses_tree("auto", _plasma(TREE_CROSSOVER), Box(10, 10, "periodic"))
+    assert uses_tree("tree", _plasma(10), Box(10, 10))
+    assert not uses_tree("direct", _plasma(TREE_CROSSOVER), Box(10, 10))
 
 
 def test_tree_in_a_periodic_box_is_refused_with_the_field():

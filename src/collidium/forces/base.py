@@ -1,0 +1,233 @@
+"""The force seam: the `Force` protocol, the registry of forces by name, and `ForceField`.
+
+Every force, a pair force (`Coulomb`, `Newton`) or an external field (`Gravity`,
+`UniformField`), gives per-particle forces, energies and virials (HOOMD's ``md.force.Force``),
+says how fast its energies change (for the adaptive integrator's substeps) and writes itself as
+a table with a ``type`` (for scenario files and checkpoints). Front ends find forces by that
+name in `FORCES`, never by their class: a new force is one module that registers itself.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import typing
+from collections.abc import Mapping
+from typing import Any, ClassVar, Protocol, TypeVar, runtime_checkable
+
+import numpy as np
+
+from collidium.errors import InputError, SimulationError
+from collidium.state import FloatArray, Particles
+from collidium.vessels import Vessel
+
+
+@runtime_checkable
+class Force(Protocol):
+    """What the integrators and front ends ask of a force (a frozen dataclass of parameters).
+
+    Attributes
+    ----------
+    name : str
+        The name in `FORCES`, the scenario file's ``type`` and checkpoints.
+    """
+
+    name: ClassVar[str]
+
+    def check(self, particles: Particles, vessel: Vessel) -> None:
+        """Refuse a set-up this force cannot act in (`InputError` naming the field)."""
+
+    def compute(
+        self,
+        particles: Particles,
+        vessel: Vessel,
+        force: FloatArray,
+        energy: FloatArray,
+        virial: FloatArray,
+        work: dict[str, np.ndarray],
+    ) -> None:
+        """Write the force on each particle into ``force`` (N, 2), in N, each particle's share of
+        the potential energy into ``energy`` (N,) and of the pair virial ``sum r_ij . F_ij`` into
+        ``virial`` (N,), both in J (their sums are the totals). ``work`` keeps buffers from call
+        to call (empty on the first)."""
+
+    def stiffness(self, particles: Particles, vessel: Vessel, acceleration: FloatArray) -> float:
+        """``S`` in J^2/s^4: a leapfrog step h errs on the energy of the part hardest to follow
+        by about ``sqrt(S) h^2`` (`collidium.integrators`); 0 for a uniform force, which leapfrog
+        follows exactly. ``acceleration`` (N, 2) is the total of the last evaluation."""
+
+    def to_dict(self) -> dict[str, object]:
+        """The parameters as a scenario table, with ``type`` = `name`."""
+
+
+#: Every force by its name (filled as the force modules are imported).
+FORCES: dict[str, type[Force]] = {}
+
+ForceType = TypeVar("ForceType", bound=type)
+
+
+def register(cls: ForceType) -> ForceType:
+    """Class decorator: put a force into `FORCES` under its ``name``."""
+    FORCES[cls.name] = cls  # type: ignore[attr-defined]
+    return cls
+
+
+def parameters(cls: type) -> dict[str, tuple[Any, Any]]:
+    """A registered force's parameters: name -> (type, default), in the order of its fields
+    (the scenario schema is made from them)."""
+    hints = typing.get_type_hints(cls)
+    return {
+        field.name: (hints[field.name], field.default)
+        for field in dataclasses.fields(cls)
+        if field.init
+    }
+
+
+def force_from_dict(data: Mapping[str, Any], where: str = "forces") -> Force:
+    """The force a scenario table describes (``type`` and parameters), as in a checkpoint.
+
+    Raises
+    ------
+    InputError
+        For an unknown ``type`` or parameter, or a parameter the force refuses, named under
+        ``where`` (e.g. ``forces.0.k``).
+    """
+    kind = data.get("type")
+    if kind not in FORCES:
+        raise InputError(
+            f"{where}.type", f"unknown force {kind!r}; choose from {', '.join(FORCES)}"
+        )
+    cls = FORCES[kind]
+    allowed = parameters(cls)
+    for key in data:
+        if key != "type" and key not in allowed:
+            raise InputError(f"{where}.{key}", f"unknown field; allowed: {', '.join(allowed)}")
+    try:
+        return cls(**{key: value for key, value in data.items() if key != "type"})
+    except InputError as exc:
+        raise InputError(f"{where}.{exc.field.rsplit('.', 1)[-1]}", exc.reason) from None
+
+
+# --- parameter checks shared by the forces -----------------------------------------------------
+
+
+def check_finite(force: str, field: str, value: float) -> None:
+    """Refuse a value that is not a finite number (field ``forces.<force>.<field>``)."""
+    if not (isinstance(value, int | float) and math.isfinite(value)):
+        raise InputError(f"forces.{force}.{field}", f"must be a finite number, got {value!r}")
+
+
+def check_at_least(force: str, field: str, value: float, low: float = 0.0) -> None:
+    """Refuse a value below ``low`` (or not a finite number)."""
+    check_finite(force, field, value)
+    if value < low:
+        raise InputError(f"forces.{force}.{field}", f"must be >= {low:g}, got {value!r}")
+
+
+def check_vector(force: str, field: str, value: Any) -> tuple[float, float]:
+    """A finite 2D vector as a tuple of floats (a list or array is accepted)."""
+    try:
+        x, y = (float(c) for c in value)
+    except (TypeError, ValueError):
+        raise InputError(
+            f"forces.{force}.{field}", f"must be two numbers (x, y), got {value!r}"
+        ) from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise InputError(f"forces.{force}.{field}", f"must be finite, got {value!r}")
+    return x, y
+
+
+def _refuse_infinite(acceleration: FloatArray) -> None:
+    """One line naming the first particle whose acceleration (N, 2) overflowed (a force on a
+    mass too small to move by it)."""
+    # A reduction on the hot path (any inf or NaN makes the sum one); the search only on failure.
+    with np.errstate(invalid="ignore", over="ignore"):  # inf - inf is the NaN looked for
+        total = float(acceleration.sum())
+    if not math.isfinite(total):
+        i = int(np.argmin(np.isfinite(acceleration).all(axis=1)))
+        raise SimulationError(
+            f"particle {i}: the force on it gives an infinite acceleration (its mass is too "
+            "small for the force)"
+        )
+
+
+class ForceField:
+    """All forces of a simulation: total acceleration and potential energy, with reused buffers.
+
+    Parameters
+    ----------
+    forces : sequence of Force
+        The forces acting; empty for free flight.
+    """
+
+    def __init__(self, forces: tuple[Force, ...]) -> None:
+        self.forces = tuple(forces)
+        self._work: list[dict[str, np.ndarray]] = [{} for _ in self.forces]
+        self._force = np.empty((0, 2))
+        self._energy = np.empty(0)
+        self._virial = np.empty(0)
+        self._evaluated_at: FloatArray | None = None
+        self._acceleration = np.empty((0, 2))
+        self._potential = 0.0
+        self._virial_sum = 0.0
+
+    @property
+    def acceleration(self) -> FloatArray:
+        """Acceleration (N, 2) in m/s^2 from the last `evaluate`."""
+        return self._acceleration
+
+    @property
+    def active(self) -> bool:
+        """True when at least one force acts."""
+        return bool(self.forces)
+
+    def evaluate(self, particles: Particles, vessel: Vessel) -> FloatArray:
+        """Total acceleration (N, 2) in m/s^2 at the current positions; also caches the potential
+        and the virial."""
+        n = particles.n
+        if self._force.shape[0] != n:
+            self._force = np.empty((n, 2))
+            self._energy = np.empty(n)
+            self._virial = np.empty(n)
+            self._acceleration = np.empty((n, 2))
+        self._acceleration[...] = 0.0
+        potential = virial = 0.0
+        for force, work in zip(self.forces, self._work, strict=True):
+            force.compute(particles, vessel, self._force, self._energy, self._virial, work)
+            self._acceleration += self._force
+            potential += float(np.sum(self._energy))
+            virial += float(np.sum(self._virial))
+        with np.errstate(over="ignore"):  # an infinite acceleration is refused just below
+            np.divide(self._acceleration, particles.mass[:, None], out=self._acceleration)
+        _refuse_infinite(self._acceleration)
+        self._potential = potential
+        self._virial_sum = virial
+        self._evaluated_at = particles.position.copy()
+        return self._acceleration
+
+    def stiffness(self, particles: Particles, vessel: Vessel) -> float:
+        """``S`` of all forces at the current state, in J^2/s^4: the largest of the forces'
+        (`Force.stiffness`, given the acceleration of the last `evaluate`)."""
+        return max(
+            (force.stiffness(particles, vessel, self._acceleration) for force in self.forces),
+            default=0.0,
+        )
+
+    def potential(self, particles: Particles, vessel: Vessel) -> float:
+        """Potential energy in J at the current positions (cached from the last evaluation)."""
+        self._refresh(particles, vessel)
+        return self._potential
+
+    def virial(self, particles: Particles, vessel: Vessel) -> float:
+        """Pair virial ``sum_{i<j} r_ij . F_ij`` in J at the current positions (of the pair
+        forces before any acceleration cap; minimum image in a periodic vessel)."""
+        self._refresh(particles, vessel)
+        return self._virial_sum
+
+    def _refresh(self, particles: Particles, vessel: Vessel) -> None:
+        if not self.active:
+            self._potential = self._virial_sum = 0.0
+        elif self._evaluated_at is None or not np.array_equal(
+            self._evaluated_at, particles.position
+        ):
+            self.evaluate(particles, vessel)
