@@ -9,21 +9,14 @@ import numpy as np
 
 from collidium.errors import InputError
 from collidium.forces.base import check_finite, register
-from collidium.forces.pair import (
-    DEFAULT_THETA,
-    SumMethod,
-    check_sum,
-    check_vessel,
-    pair_stiffness,
-    pair_sum,
-)
+from collidium.forces.pair import DEFAULT_THETA, InverseDistanceForce, SumMethod
 from collidium.state import FloatArray, Particles
 from collidium.vessels import Vessel
 
 
 @register
 @dataclass(frozen=True)
-class Coulomb:
+class Coulomb(InverseDistanceForce):
     """Coulomb interaction (seed eq. 9-10, softened).
 
     ``F = k q_i q_j r / (r^2 + eps^2)^(3/2)`` and ``U = k q_i q_j / sqrt(r^2 + eps^2)``.
@@ -53,6 +46,7 @@ class Coulomb:
     """
 
     name: ClassVar[str] = "coulomb"
+    source: ClassVar[str] = "charge"
 
     k: float = 5.0
     softening: float = 0.0
@@ -62,16 +56,17 @@ class Coulomb:
 
     def __post_init__(self) -> None:
         check_finite(self.name, "k", self.k)
-        check_sum(self.name, self.softening, self.method, self.theta)
+        super().__post_init__()
         cap = self.max_acceleration
         if cap is not None:
             check_finite(self.name, "max_acceleration", cap)
             if cap <= 0:
                 raise InputError("forces.coulomb.max_acceleration", f"must be > 0, got {cap!r}")
 
-    def check(self, particles: Particles, vessel: Vessel) -> None:
-        """Refuse the tree in a periodic vessel (it cannot follow the minimum image)."""
-        check_vessel(self.name, self.method, vessel)
+    @property
+    def coupling(self) -> float:
+        """``k``."""
+        return self.k
 
     def compute(
         self,
@@ -84,27 +79,14 @@ class Coulomb:
     ) -> None:
         """The pair sum of the charges (`collidium.forces.base.Force.compute`), then the
         limiter, if any, on each particle's force over its mass."""
-        pair_sum(
-            particles.charge, self.k, self.softening, self.method, self.theta, particles, vessel,
-            (force, energy, virial), work,
-        )  # fmt: skip
+        super().compute(particles, vessel, force, energy, virial, work)
         if self.max_acceleration is not None:
             pull = np.hypot(force[:, 0], force[:, 1]) / particles.mass
             force /= np.sqrt(1.0 + (pull / self.max_acceleration) ** 2)[:, None]
-
-    def stiffness(self, particles: Particles, vessel: Vessel, acceleration: FloatArray) -> float:
-        """How fast the pair energies change (`collidium.forces.pair.pair_stiffness`)."""
-        return pair_stiffness(
-            particles.charge, self.k, self.softening, self.method, particles, vessel, acceleration
-        )
 
     def to_dict(self) -> dict[str, object]:
         """Parameters as in a scenario file (defaults of the optional ones omitted)."""
         out: dict[str, object] = {"type": self.name, "k": self.k, "softening": self.softening}
         if self.max_acceleration is not None:
             out["max_acceleration"] = self.max_acceleration
-        if self.method != "auto":
-            out["method"] = self.method
-        if self.theta != DEFAULT_THETA:
-            out["theta"] = self.theta
-        return out
+        return out | self.summation()

@@ -5,25 +5,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-import numpy as np
-
 from collidium.forces.base import check_at_least, register
-from collidium.forces.pair import (
-    DEFAULT_THETA,
-    SumMethod,
-    check_sum,
-    check_vessel,
-    pair_stiffness,
-    pair_sum,
-)
+from collidium.forces.pair import DEFAULT_THETA, InverseDistanceForce, SumMethod
 from collidium.forces.uniform import UniformForce
-from collidium.state import FloatArray, Particles
-from collidium.vessels import Vessel
 
 
 @register
 @dataclass(frozen=True)
-class Newton:
+class Newton(InverseDistanceForce):
     """Newton's gravitation between every pair of particles, softened.
 
     ``F = -G m_i m_j r / (r^2 + eps^2)^(3/2)`` (attractive) and
@@ -43,6 +32,7 @@ class Newton:
     """
 
     name: ClassVar[str] = "newton"
+    source: ClassVar[str] = "mass"
 
     G: float = 1.0
     softening: float = 0.0
@@ -51,41 +41,16 @@ class Newton:
 
     def __post_init__(self) -> None:
         check_at_least(self.name, "G", self.G)
-        check_sum(self.name, self.softening, self.method, self.theta)
+        super().__post_init__()
 
-    def check(self, particles: Particles, vessel: Vessel) -> None:
-        """Refuse the tree in a periodic vessel (it cannot follow the minimum image)."""
-        check_vessel(self.name, self.method, vessel)
-
-    def compute(
-        self,
-        particles: Particles,
-        vessel: Vessel,
-        force: FloatArray,
-        energy: FloatArray,
-        virial: FloatArray,
-        work: dict[str, np.ndarray],
-    ) -> None:
-        """The pair sum of the masses (`collidium.forces.base.Force.compute`)."""
-        pair_sum(
-            particles.mass, -self.G, self.softening, self.method, self.theta, particles, vessel,
-            (force, energy, virial), work,
-        )  # fmt: skip
-
-    def stiffness(self, particles: Particles, vessel: Vessel, acceleration: FloatArray) -> float:
-        """How fast the pair energies change (`collidium.forces.pair.pair_stiffness`)."""
-        return pair_stiffness(
-            particles.mass, -self.G, self.softening, self.method, particles, vessel, acceleration
-        )
+    @property
+    def coupling(self) -> float:
+        """``-G``: the masses attract."""
+        return -self.G
 
     def to_dict(self) -> dict[str, object]:
         """Parameters as in a scenario file (the default method and angle omitted)."""
-        out: dict[str, object] = {"type": self.name, "G": self.G, "softening": self.softening}
-        if self.method != "auto":
-            out["method"] = self.method
-        if self.theta != DEFAULT_THETA:
-            out["theta"] = self.theta
-        return out
+        return {"type": self.name, "G": self.G, "softening": self.softening} | self.summation()
 
 
 @register

@@ -8,7 +8,7 @@ same kernels, directly (`collidium.kernels.pairwise`) or by Barnes-Hut tree
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 
@@ -118,3 +118,58 @@ def pair_stiffness(
     speed2 = np.einsum("ij,ij->i", particles.velocity, particles.velocity)
     error = particles.mass * pull * (speed2 / length + pull)
     return float(np.max(error * error, initial=0.0))
+
+
+class InverseDistanceForce:
+    """The behaviour of an inverse-distance pair force, for a frozen dataclass with the fields
+    ``softening``, ``method`` and ``theta``: its sources are the particles' `source` array
+    ("charge" or "mass") and its coupling `coupling`."""
+
+    name: ClassVar[str]
+    source: ClassVar[str]
+    softening: float
+    method: SumMethod
+    theta: float
+
+    @property
+    def coupling(self) -> float:
+        """``c`` in ``U_ij = c s_i s_j / sqrt(r^2 + eps^2)``."""
+        raise NotImplementedError
+
+    def __post_init__(self) -> None:
+        check_sum(self.name, self.softening, self.method, self.theta)
+
+    def check(self, particles: Particles, vessel: Vessel) -> None:
+        """Refuse the tree in a periodic vessel (it cannot follow the minimum image)."""
+        check_vessel(self.name, self.method, vessel)
+
+    def compute(
+        self,
+        particles: Particles,
+        vessel: Vessel,
+        force: FloatArray,
+        energy: FloatArray,
+        virial: FloatArray,
+        work: dict[str, np.ndarray],
+    ) -> None:
+        """The pair sum of the sources (`collidium.forces.base.Force.compute`)."""
+        pair_sum(
+            getattr(particles, self.source), self.coupling, self.softening, self.method,
+            self.theta, particles, vessel, (force, energy, virial), work,
+        )  # fmt: skip
+
+    def stiffness(self, particles: Particles, vessel: Vessel, acceleration: FloatArray) -> float:
+        """How fast the pair energies change (`pair_stiffness`)."""
+        return pair_stiffness(
+            getattr(particles, self.source), self.coupling, self.softening, self.method,
+            particles, vessel, acceleration,
+        )  # fmt: skip
+
+    def summation(self) -> dict[str, object]:
+        """The summation settings as in a scenario file, those at their defaults left out."""
+        out: dict[str, object] = {}
+        if self.method != "auto":
+            out["method"] = self.method
+        if self.theta != DEFAULT_THETA:
+            out["theta"] = self.theta
+        return out
