@@ -347,11 +347,14 @@ class _ForceSpec(_Model):
 
 def _schema_type(kind: Any) -> Any:
     """The schema's type for a force parameter's annotation: floats finite, a 2D vector a list
-    of two (as TOML gives it), anything else (a Literal, None) as it is."""
+    of two (as TOML gives it), anything else (a Literal, None) as it is.
+
+    Each field gets its own copy of the alias: pydantic 2.6 writes a field's default into the
+    ``FieldInfo`` of its annotation, which a shared alias would carry into later models."""
     if kind is float:
-        return Finite
+        return copy.deepcopy(Finite)
     if get_origin(kind) is tuple:
-        return Vector
+        return copy.deepcopy(Vector)
     if get_origin(kind) in (Union, type(int | None)):
         return Union[tuple(_schema_type(arm) for arm in kind.__args__)]  # noqa: UP007
     return kind
@@ -363,9 +366,10 @@ def _plain(default: Any) -> Any:
 
 
 def _force_spec(name: str, cls: type) -> type[_ForceSpec]:
-    """The schema model of a registered force, from its parameters."""
+    """The schema model of a registered force, from its parameters (a required one as
+    ``Field()``: pydantic 2.6 takes ``...`` beside an annotated type for its default)."""
     fields: dict[str, Any] = {
-        key: (_schema_type(kind), ... if default is dataclasses.MISSING else _plain(default))
+        key: (_schema_type(kind), Field() if default is dataclasses.MISSING else _plain(default))
         for key, (kind, default) in parameters(cls).items()
     }
     model: type[_ForceSpec] = create_model(
