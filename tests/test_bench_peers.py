@@ -130,3 +130,21 @@ def test_pymunk_balls_in_a_child_process():
     result = peers.pymunk_balls(200, steps=10, isolate=True)
     assert result["isolated"] is True and result["steps"] == 10 and result["n"] == 200
     assert result["particle_steps_per_second"] > 0
+
+
+def test_bench_gravity_times_the_same_law_as_rebound():
+    """collidium's Newton on the benchmark's square gives peers.direct_accelerations (REBOUND's
+    law, checked above against REBOUND itself), and the benchmark reports sane figures."""
+    import bench_gravity
+    import collidium as cd
+    from collidium.forces import ForceField
+
+    position = peers._uniform_square(300, seed=4)
+    particles = cd.Particles(position, mass=1.0 / 300, radius=0.0)
+    newton = cd.Newton(G=1.0, softening=bench_gravity.SOFTENING, method="direct")
+    ours = ForceField((newton,)).evaluate(particles, cd.Box(30, 30))
+    exact = peers.direct_accelerations(position, 1.0 / 300, np.arange(300), 0.01)
+    np.testing.assert_allclose(ours, exact, rtol=1e-10, atol=1e-12 * np.abs(exact).max())
+    row = bench_gravity.newton_step(600, "tree", max_seconds=0.05)
+    json.dumps(row)
+    assert row["force_error_rms"] < 1e-3 and row["us_per_particle_step"] > 0

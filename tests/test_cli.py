@@ -108,6 +108,16 @@ OUTSIDE = '[[particles]]\nkind = "explicit"\nposition = [[0.0, 0.0], [12.0, 0.0]
 DT_ZERO = '[run]\ndt = 0.0\n[[particles]]\nkind = "random"\nn = 3\n'
 UNKNOWN_FORCE = '[[forces]]\ntype = "yukawa"\n[[particles]]\nkind = "random"\nn = 3\n'
 NEGATIVE_G = '[[forces]]\ntype = "newton"\nG = -1.0\n[[particles]]\nkind = "random"\nn = 3\n'
+COLD_BATH = (
+    '[[forces]]\ntype = "langevin"\ntemperature = 0.0\n[[particles]]\nkind = "random"\nn = 3\n'
+)
+NEGATIVE_GAMMA = (
+    '[[forces]]\ntype = "linear_drag"\ngamma = -2.0\n[[particles]]\nkind = "random"\nn = 3\n'
+)
+BAD_MAP = (
+    '[[forces]]\ntype = "field_map"\npotential = [[1.0, 2.0], [3.0]]\n'
+    '[[particles]]\nkind = "random"\nn = 3\n'
+)
 PISTON_OUTSIDE = (
     '[vessel.walls.top]\nresponse = "piston"\nposition = 11.0\n'
     '[[particles]]\nkind = "random"\nn = 3\n'
@@ -133,6 +143,10 @@ PISTON_STEP = (
         (["run", "{file}"], DT_ZERO, "run.dt"),
         (["run", "{file}"], UNKNOWN_FORCE, "forces.0.type"),
         (["run", "{file}"], NEGATIVE_G, "forces.0.G"),
+        (["run", "{file}"], COLD_BATH, "forces.0.temperature"),
+        (["run", "{file}"], NEGATIVE_GAMMA, "forces.0.gamma"),
+        (["run", "{file}"], BAD_MAP, "forces.0.potential"),
+        (["run", "drag", "--set", "gamma=-1"], None, "gamma"),
         (["run", "{file}"], OVERLAP, "particles.0.position.1"),
         (["run", "{file}"], OUTSIDE, "particles.0.position.1"),
         (["run", "{file}"], PISTON_OUTSIDE, "vessel.walls.top.position"),

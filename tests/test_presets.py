@@ -11,6 +11,7 @@ import pytest
 from collidium import load, restore, theory
 from collidium.errors import InputError
 from collidium.loading import load_scenario
+from collidium.observers import Every, TemperatureProfile, VirialRatio
 from collidium.presets import PRESETS, describe_presets, parameters, preset, presets
 from collidium.scenario import Scenario
 
@@ -35,6 +36,9 @@ SECTIONS = {
     "effusion": "5",
     "atmosphere": "5",
     "projectile": "5",
+    "spectrometer": "5",
+    "galaxy": "5",
+    "drag": "5",
 }
 
 # name -> (positions, velocities, masses, charges, radius, Coulomb (k, softening) or None)
@@ -87,10 +91,11 @@ def test_default_vessel_and_run(name):
     assert scenario.run.collisions == "exact"
     times = {"pool-break": 60.0, "heat-flow": 60.0, "brownian": 300.0, "granular": 30.0,
              "piston": 60.0, "effusion": 200.0, "hard-disks": 50.0, "atmosphere": 120.0,
-             "projectile": 5.0}  # fmt: skip
+             "projectile": 5.0, "spectrometer": 14.0, "galaxy": 40.0}  # fmt: skip
     assert scenario.run.time == times.get(name, 10.0)
-    if name == "circle-gas":
-        assert scenario.to_dict()["vessel"] == {"shape": "circle", "radius": 11.3}
+    if name in ("circle-gas", "galaxy"):
+        radius = {"circle-gas": 11.3, "galaxy": 20.0}[name]
+        assert scenario.to_dict()["vessel"] == {"shape": "circle", "radius": radius}
         return
     if name == "brownian":  # a periodic box, for a walk longer than a box
         assert scenario.to_dict()["vessel"] == {"shape": "box", "width": 40.0, "height": 40.0,
@@ -109,7 +114,8 @@ def test_default_vessel_and_run(name):
         return
     assert scenario.vessel.boundary == "reflecting"
     size = {"pool-break": (40.0, 20.0), "heat-flow": (40.0, 10.0), "piston": (20.0, 40.0),
-            "effusion": (40.0, 20.0), "atmosphere": (40.0, 100.0)}  # fmt: skip
+            "effusion": (40.0, 20.0), "atmosphere": (40.0, 100.0), "spectrometer": (24.0, 14.0),
+            "drag": (12.0, 40.0)}  # fmt: skip
     size = size.get(name, (20.0, 20.0))
     assert (scenario.vessel.width, scenario.vessel.height) == size
 
@@ -492,3 +498,71 @@ def test_projectile_falls_on_the_parabola_and_lands_at_the_textbook_range():
     assert sim.counters.wall_hits["bottom"] == 0 and t < landing
     sim.run(time=0.01)  # just after: one bounce on the floor
     assert sim.counters.wall_hits["bottom"] == 1 and sim.time > landing
+
+
+def test_spectrometer_ions_land_two_radii_from_the_slit():
+    """Each ion turns on a half circle of radius m v / (q B) (2, 4 and 6 m) and lands on the
+    floor at x = -10 + 2 r. It crosses the field's edge twice, each to O(omega h) in the
+    direction (h the substep, omega h <= the tolerance): over the 4 m down to the floor that
+    is within a few mm."""
+    sim = preset("spectrometer").build()
+    landed: dict[int, float] = {}
+    while len(landed) < 3 and sim.time < 14.0:
+        before = sim.particles.velocity[:, 1].copy()
+        sim.run(steps=1)
+        for i in np.flatnonzero((before < 0) & (sim.particles.velocity[:, 1] > 0)):
+            landed.setdefault(int(i), float(sim.particles.position[i, 0]))
+    masses = sim.particles.mass
+    for i, x in landed.items():
+        assert x == pytest.approx(-10 + 2 * theory.cyclotron_radius(masses[i], 2.0, 1.0, 1.0),
+                                  abs=0.01)  # fmt: skip
+    assert len(landed) == 3
+
+
+def test_drag_disks_reach_their_terminal_velocities():
+    """After 10 s (at least 3.3 time constants m / gamma) each disk falls at
+    m g / gamma (1 - exp(-t gamma / m)), the exact solution, to the substeps' O(h^2)."""
+    sim = preset("drag").build().run(time=10.0)
+    masses = sim.particles.mass
+    terminal = np.array([theory.terminal_velocity(m, 1.0, 1.0) for m in masses])
+    want = terminal * (1 - np.exp(-10.0 / masses))
+    np.testing.assert_allclose(-sim.particles.velocity[:, 1], want, rtol=sim.tolerance**2)
+
+
+def test_galaxy_settles_to_virial_equilibrium():
+    """A fifth of the galaxy with five times G (the same G M: the same free-fall time, 13 s, and
+    speeds): after the collapse the bound cluster's 2 KE / |W| comes to 1 (the virial theorem),
+    within 0.15: a 1000-disk cluster still swings by about a tenth a few free-fall times on,
+    and the fixed step's energy error (1e-2 here) moves it as much."""
+    sim = preset("galaxy", n=1000, G=0.05).build()
+    sim.run(time=40.0)
+    (virial,) = [o for o in sim.observers if isinstance(o, VirialRatio)]
+    assert virial.time[0] == pytest.approx(25.0, abs=0.01)
+    assert abs(virial.summary()["mean_virial_ratio"] - 1.0) < 0.15
+    assert 0.8 < virial.summary()["bound_fraction"] < 1.0
+
+
+def test_atmosphere_follows_the_barometric_law_where_dilute():
+    """A smaller atmosphere (400 disks, 20 m x 40 m, kT about 16 J, scale height kT / (m g)
+    about 16 m), relaxed for 40 s and measured over 200 s in 10 slices. In the upper half
+    (packing below 0.012, where the gas is ideal to a few parts in a thousand) each slice's
+    density is ``A exp(-m g y / kT)`` within 3 standard errors (block averages), kT the slices'
+    mean and A fitted; the error of kT adds to each slice's by how far it lies from their
+    middle. The slices' kT agree with each other (one temperature at every height)."""
+    sim = load("atmosphere", n=400, width=20.0, height=40.0, speed=5.0, seed=3)
+    sim.observers = []
+    sim.run(time=40.0)
+    profile = TemperatureProfile(bins=10, axis="y", trigger=Every(10))
+    sim.observers = [profile]
+    sim.run(time=200.0)
+    top = profile.centres > 0
+    y, density, error = profile.centres[top], profile.density[top], profile.density_error()[top]
+    kT_each, kT_error = profile.temperature[top], profile.temperature_error()[top]
+    weights = 1 / kT_error**2
+    kT = np.sum(weights * kT_each) / np.sum(weights)
+    assert np.all(np.abs(kT_each - kT) <= 3 * kT_error)
+    shape = theory.barometric_density(y - y.mean(), 1.0, 1.0, kT)
+    slope_error = density * np.abs(y - y.mean()) / kT**2 / math.sqrt(np.sum(weights))
+    sigma = np.hypot(error, slope_error)
+    amplitude = np.sum(density * shape / sigma**2) / np.sum(shape**2 / sigma**2)
+    assert np.all(np.abs(density - amplitude * shape) <= 3 * sigma)

@@ -1,5 +1,5 @@
-"""collidium: particles in a 2D vessel with exact elastic collisions, Coulomb forces, gravity
-and fields.
+"""collidium: particles in a 2D vessel with exact elastic collisions, Coulomb forces, gravity,
+electric and magnetic fields, drag and a thermostat.
 
 >>> import collidium as cd
 >>> sim = cd.load("gas", n=500, seed=3)
@@ -10,7 +10,18 @@ from typing import Any
 
 from collidium import observers
 from collidium.errors import InputError, SimulationError
-from collidium.forces import Coulomb, Gravity, Newton, UniformField
+from collidium.forces import (
+    Coulomb,
+    FieldMap,
+    Friction,
+    Gravity,
+    Langevin,
+    LinearDrag,
+    MagneticField,
+    Newton,
+    QuadraticDrag,
+    UniformField,
+)
 from collidium.loading import load
 from collidium.presets import presets
 from collidium.simulation import Counters, Energy, Simulation, restore
@@ -23,12 +34,18 @@ __all__ = [
     "Coulomb",
     "Counters",
     "Energy",
+    "FieldMap",
+    "Friction",
     "Gravity",
     "InputError",
+    "Langevin",
+    "LinearDrag",
+    "MagneticField",
     "Newton",
     "Particles",
     "Partition",
     "Polygon",
+    "QuadraticDrag",
     "Simulation",
     "SimulationError",
     "UniformField",

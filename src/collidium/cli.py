@@ -567,6 +567,11 @@ def _print_summary(summary: dict[str, Any]) -> None:
         ("wall collisions", f"{summary['collisions']['wall']}"),
         ("all collisions", f"{summary['collisions']['pair'] + summary['collisions']['wall']}"),
         *_heat_rows(summary["wall_heat"]),
+        *(
+            [("force heat (given to the gas)", f"{summary['force_heat']:.6g} J")]
+            if summary.get("force_heat")
+            else []
+        ),
         ("collision rate", _number(summary["collisions"]["rate"], "/s")),
         ("temperature kT", _for_a_gas(summary, _number(summary["temperature"], "J"))),
         ("wall pressure", _number(pressure["wall"], "N/m", pressure["wall_error"])),

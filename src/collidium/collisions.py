@@ -59,12 +59,16 @@ class Tally:
     piston : ndarray of float64, shape (2,) or (0,)
         The piston's face position (m) and velocity (m/s) along its axis now; empty without
         a piston (`collidium.vessels.walls.Piston`).
+    forces : ndarray of float64, shape (1,)
+        The energy the velocity forces (drag, friction, a thermostat) have given the disks (J;
+        negative: the heat they took), kept by the integrators.
     """
 
     counts: IntArray
     impulse: FloatArray
     heat: FloatArray
     piston: FloatArray = field(default_factory=lambda: np.empty(0))
+    forces: FloatArray = field(default_factory=lambda: np.zeros(1))
 
     @classmethod
     def for_walls(cls, walls: int) -> Tally:

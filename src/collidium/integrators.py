@@ -8,6 +8,12 @@ Two integrators advance the state over one reporting interval ``dt``:
 - `Leapfrog` (``"fixed"``): one kick-drift-kick step of ``dt``, the seed's scheme, kept to
   reproduce its results (energy error O(dt^2), and O(dt^2) per collision under forces).
 
+Forces of the velocities (a magnetic field, drag, friction, a thermostat:
+`collidium.forces.base.VelocityForce`) act by their exact flow for half a substep before each
+kick-drift-kick and half after, a time-symmetric (Strang) splitting: a magnetic field turns
+velocities without changing speeds, and the energy drag or a thermostat gives the particles is
+kept in ``Tally.forces``.
+
 Without forces both are the same single drift: the exact engine is then untouched.
 """
 
@@ -140,9 +146,9 @@ class Leapfrog(Integrator):
         dt: float,
         tally: Tally,
     ) -> None:
-        particles.velocity += (0.5 * dt) * field.acceleration
+        _kick(particles, vessel, field, dt, tally)
         drift.drift(particles, vessel, now, dt, tally, field.acceleration)
-        particles.velocity += (0.5 * dt) * field.evaluate(particles, vessel)
+        _closing_kick(particles, vessel, field, dt, tally)
 
 
 class AdaptiveLeapfrog(Integrator):
@@ -273,20 +279,38 @@ class AdaptiveLeapfrog(Integrator):
         halt_after = t + CONTACT_WINDOW * dt
         reached = end
         while True:
-            particles.velocity += (0.5 * h) * acceleration
+            _kick(particles, vessel, field, h, tally)
             contact = drift.drift(particles, vessel, t, h, tally, acceleration, halt_after)
             if contact is None:
                 break
             before.restore(particles, tally)
+            # From the velocities before the velocity forces' half: they turn a velocity by
+            # at most ``tolerance`` in it, within the margin the drift takes contacts in.
             shortened = _shortened(particles, vessel, acceleration, contact, t, h, dt)
             if shortened > CONTACT_WINDOW * dt:
                 h, reached = shortened, t + shortened
-                particles.velocity += (0.5 * h) * acceleration
+                _kick(particles, vessel, field, h, tally)
                 drift.drift(particles, vessel, t, h, tally, acceleration)
                 break
             halt_after = contact.time
-        particles.velocity += (0.5 * h) * field.evaluate(particles, vessel)
+        _closing_kick(particles, vessel, field, h, tally)
         return reached
+
+
+def _kick(particles: Particles, vessel: Vessel, field: ForceField, h: float, tally: Tally) -> None:
+    """What comes before the drift of a substep ``h``: the velocity forces for ``h / 2``, then
+    the kick ``a h / 2`` of the position forces."""
+    tally.forces[0] += field.advance(particles, vessel, 0.5 * h, first=True)
+    particles.velocity += (0.5 * h) * field.acceleration
+
+
+def _closing_kick(
+    particles: Particles, vessel: Vessel, field: ForceField, h: float, tally: Tally
+) -> None:
+    """What comes after the drift, in the mirror order of `_kick`: the forces at the new
+    positions, their kick ``a h / 2``, then the velocity forces for ``h / 2``."""
+    particles.velocity += (0.5 * h) * field.evaluate(particles, vessel)
+    tally.forces[0] += field.advance(particles, vessel, 0.5 * h, first=False)
 
 
 def _squared_rate(particles: Particles, vessel: Vessel, field: ForceField) -> float:
@@ -294,12 +318,15 @@ def _squared_rate(particles: Particles, vessel: Vessel, field: ForceField) -> fl
     squared second of the pair hardest to follow, `ForceField.stiffness`) over the total energy
     ``|KE + U|``, the scale the energy error is judged against, but never below a tenth of
     ``KE + |U|`` (a total near zero would ask for endless substeps). A leapfrog step h then errs on
-    the energy by about ``h^2 rate^2`` of that scale."""
+    the energy by about ``h^2 rate^2`` of that scale. The velocity forces' own rate
+    (`ForceField.rate`) counts too: a substep turns or damps a velocity by at most
+    ``tolerance`` of it."""
     p = particles
     kinetic = 0.5 * float(np.sum(p.mass * np.einsum("ij,ij->i", p.velocity, p.velocity)))
     potential = field.potential(particles, vessel)
     scale = max(abs(kinetic + potential), (kinetic + abs(potential)) / TOTAL_ENERGY_FLOOR)
-    return math.sqrt(field.stiffness(particles, vessel)) / scale if scale > 0.0 else 0.0
+    energy = math.sqrt(field.stiffness(particles, vessel)) / scale if scale > 0.0 else 0.0
+    return max(energy, field.rate(particles, vessel) ** 2)
 
 
 def _shortened(
@@ -378,6 +405,7 @@ class _Snapshot:
         self.impulse = tally.impulse.copy()
         self.heat = tally.heat.copy()
         self.piston = tally.piston.copy()
+        self.forces = tally.forces.copy()
 
     def restore(self, particles: Particles, tally: Tally) -> None:
         """Put everything back as it was taken."""
@@ -388,3 +416,4 @@ class _Snapshot:
         tally.impulse[...] = self.impulse
         tally.heat[...] = self.heat
         tally.piston[...] = self.piston
+        tally.forces[...] = self.forces

@@ -565,6 +565,95 @@ def projectile(
     }
 
 
+@_preset(
+    "spectrometer",
+    "5",
+    "ions of three masses enter a magnetic field and land apart: radius m v / (q B)",
+    title="ions of {mass:g} to 3 x {mass:g} kg at {speed:g} m/s into B = {field:g} T",
+    width=24.0,
+    height=14.0,
+    time=14.0,
+)
+def spectrometer(
+    mass: float, radius: float, *, speed: float = 2.0, field: float = 1.0, charge: float = 1.0
+) -> dict[str, Any]:
+    """A mass spectrometer: three ions of charge ``charge`` (C) and masses ``mass``, 2 ``mass``
+    and 3 ``mass`` leave a slit at x = -10 m upwards at ``speed`` (m/s), one behind the other,
+    into a magnetic field ``field`` (T) that fills the box above y = -3 m. Each turns on a half
+    circle of radius ``m v / (q B)`` (`collidium.theory.cyclotron_radius`) and comes down at
+    x = -10 + 2 r: 2 m, 4 m and 6 m apart at the defaults, where they land on the floor."""
+    masses = [3 * mass, 2 * mass, mass]  # the lightest nearest the field, first in
+    start = [[-10.0, y] for y in (-6.5, -5.5, -4.5)]
+    ions = _pair(start, [[0.0, speed]] * 3, masses, radius, charge)
+    magnet = {"type": "magnetic_field", "B": field, "region": [[-12.0, -3.0], [12.0, 7.0]]}
+    return {"particles": [ions], "forces": [magnet]}
+
+
+@_preset(
+    "galaxy",
+    "5",
+    "a cluster of disks held together by Newton's gravity settles to virial equilibrium",
+    common=(*(key for key in _NEUTRAL if key not in ("width", "height")), "vessel_radius"),
+    title="{n} disks under their own gravity (G = {G:g}): virial ratio 2 KE / |U| towards 1",
+    radius=0.02,
+    vessel_radius=20.0,
+    time=40.0,
+    integrator="fixed",
+)
+def galaxy(
+    mass: float,
+    radius: float,
+    *,
+    n: int = 5000,
+    G: float = 0.01,
+    speed: float = 1.25,
+    softening: float = 0.1,
+) -> dict[str, Any]:
+    """``n`` disks at random in a circle of radius 20 m, velocity components uniform in
+    ``[-speed, speed]``, attracting each other by Newton's law (summed by tree, softened by
+    ``softening``) and colliding. The start is cold, 2 KE / |U| about 0.5 at the defaults
+    (``|U| = 8 G M^2 / (3 pi R)`` for a uniform disk): the cluster falls in within the free-fall
+    time ``sqrt(R^3 / (G M))``, 13 s, bounces, throws off a tenth of its disks (the rim sends
+    them back) and settles in a few free-fall times: the bound cluster's virial ratio
+    ``2 KE / |W|`` (`collidium.observers.VirialRatio`, measured from 25 s on) comes to about 1,
+    the virial theorem for an inverse-distance force.
+
+    The step is fixed (``integrator = "fixed"``), holding the energy to 1e-3 over the 40 s: its
+    error comes from the collisions under forces (4e-5 with ``collisions = "off"``), each taken
+    between kicks. After the collapse the dense core has 1e4 collisions a second, and the
+    adaptive integrator, which evaluates the tree again at each of them, would take about 40
+    wall seconds per simulated second (``--set run.integrator=adaptive``: 1e-7 over the first
+    3 s)."""
+    return {
+        "particles": gas(mass, radius, n=n, speed=speed),
+        "forces": [{"type": "newton", "G": G, "softening": softening, "method": "tree"}],
+        "observers": [
+            {"kind": "energy", "interval": 1.0},
+            {"kind": "virial", "interval": 1.0, "after": 25.0},
+        ],
+    }
+
+
+@_preset(
+    "drag",
+    "5",
+    "disks of three masses fall through a fluid and reach terminal velocities m g / gamma",
+    title="disks of {mass:g} to 3 x {mass:g} kg falling with drag gamma = {gamma:g} kg/s",
+    width=12.0,
+    height=40.0,
+    time=10.0,
+)
+def drag(mass: float, radius: float, *, g: float = 1.0, gamma: float = 1.0) -> dict[str, Any]:
+    """Three disks of masses ``mass``, 2 ``mass`` and 3 ``mass`` dropped from rest at y = 15 m
+    under gravity ``g`` (m/s^2) with linear drag ``gamma`` (kg/s): each speeds up with the time
+    constant ``m / gamma`` to its terminal velocity ``m g / gamma``
+    (`collidium.theory.terminal_velocity`), 1, 2 and 3 m/s at the defaults."""
+    disks = _pair([[-3.0, 15.0], [0.0, 15.0], [3.0, 15.0]], [[0.0, 0.0]] * 3,
+                  [mass, 2 * mass, 3 * mass], radius)  # fmt: skip
+    forces = [{"type": "gravity", "g": [0.0, -g]}, {"type": "linear_drag", "gamma": gamma}]
+    return {"particles": [disks], "forces": forces}
+
+
 def presets() -> list[str]:
     """Names of the presets, in the seed report's order."""
     return list(PRESETS)

@@ -90,6 +90,7 @@ from pydantic import (
 
 from collidium.errors import InputError
 from collidium.forces import FORCES, Force, parameters
+from collidium.forces.base import parameter_path
 from collidium.initial import (
     CLOSE_PACKING,
     balanced_charges,
@@ -113,6 +114,7 @@ from collidium.observers import (
     Thermo,
     Tracer,
     Trigger,
+    VirialRatio,
 )
 from collidium.simulation import Simulation, outside_detail, overlap_detail
 from collidium.state import FloatArray, Particles, uniform_or_each
@@ -346,15 +348,20 @@ class _ForceSpec(_Model):
 
 
 def _schema_type(kind: Any) -> Any:
-    """The schema's type for a force parameter's annotation: floats finite, a 2D vector a list
-    of two (as TOML gives it), anything else (a Literal, None) as it is.
+    """The schema's type for a force parameter's annotation: floats finite, a tuple (a 2D
+    vector, a pair of corners, a grid's rows) a list of its length (as TOML gives it),
+    anything else (a Literal, None) as it is.
 
-    Each field gets its own copy of the alias: pydantic 2.6 writes a field's default into the
+    Each field gets its own annotation: pydantic 2.6 writes a field's default into the
     ``FieldInfo`` of its annotation, which a shared alias would carry into later models."""
     if kind is float:
         return copy.deepcopy(Finite)
     if get_origin(kind) is tuple:
-        return copy.deepcopy(Vector)
+        items = kind.__args__
+        if items[-1] is Ellipsis:  # any length: the force checks it
+            return list[_schema_type(items[0])]  # type: ignore[misc]
+        size = len(items)
+        return Annotated[list[_schema_type(items[0])], Field(min_length=size, max_length=size)]  # type: ignore[misc]
     if get_origin(kind) in (Union, type(int | None)):
         return Union[tuple(_schema_type(arm) for arm in kind.__args__)]  # noqa: UP007
     return kind
@@ -362,7 +369,7 @@ def _schema_type(kind: Any) -> Any:
 
 def _plain(default: Any) -> Any:
     """A default as the schema holds it: a vector as a list."""
-    return list(default) if isinstance(default, tuple) else default
+    return [_plain(item) for item in default] if isinstance(default, tuple) else default
 
 
 def _force_spec(name: str, cls: type) -> type[_ForceSpec]:
@@ -456,6 +463,16 @@ class ThermoSpec(_ObserverSpec):
         return Thermo(self.trigger())
 
 
+class VirialSpec(_ObserverSpec):
+    """`VirialRatio`: ``2 KE / |W|`` of the bound cluster over time."""
+
+    kind: Literal["virial"] = "virial"
+
+    def build(self) -> Observer:
+        """The observer this describes."""
+        return VirialRatio(self.trigger())
+
+
 class ProfileSpec(_ObserverSpec):
     """`TemperatureProfile`: kT in ``bins`` slices across ``axis``."""
 
@@ -528,7 +545,8 @@ ObserverSpec = Annotated[
     | CollisionsSpec
     | TracerSpec
     | EffusionSpec
-    | TrajectorySpec,
+    | TrajectorySpec
+    | VirialSpec,
     Field(discriminator="kind"),
 ]
 
@@ -756,6 +774,7 @@ _TAGGED: dict[str, type[_Model]] = {
     "tracer": TracerSpec,
     "effusion": EffusionSpec,
     "trajectory": TrajectorySpec,
+    "virial": VirialSpec,
     **_FORCE_SPECS,
 }
 
@@ -1328,7 +1347,7 @@ def _reason(error: Any) -> tuple[str, str]:
     if kind == "value_error":
         problem = ctx.get("error")
         if isinstance(problem, InputError) and loc[:1] == ["forces"]:  # a force's own check
-            return f"{path}.{problem.field.rsplit('.', 1)[-1]}", problem.reason
+            return f"{path}.{parameter_path(problem)}", problem.reason
         return path, str(problem or error["msg"])
     message = error["msg"]
     message = message[0].lower() + message[1:]

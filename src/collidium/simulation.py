@@ -188,7 +188,7 @@ class Simulation:
         self.steps = 0
         self.observers: list[Observer] = []
         self._attached: list[Observer] = []  # observers already attached (by identity)
-        self._field = ForceField(tuple(forces))
+        self._field = ForceField(tuple(forces), self.rng)
         self._restitution = float(restitution)
         self._drift = make_drift(collisions, self._restitution)
         self._integrator = make_integrator("adaptive", DEFAULT_TOLERANCE)
@@ -303,7 +303,7 @@ class Simulation:
     @forces.setter
     def forces(self, forces: Sequence[Force]) -> None:
         _check_forces(forces, self.container, self.particles)
-        self._field = ForceField(tuple(forces))
+        self._field = ForceField(tuple(forces), self.rng)
 
     def add_particles(self, new: Particles) -> None:
         """Put ``new`` particles into the vessel, after the others (a pump, a source).
@@ -480,6 +480,11 @@ class Simulation:
         what they took; 0 when elastic)."""
         return float(self.tally.heat[0])
 
+    def force_heat(self) -> float:
+        """Energy the velocity forces (drag, friction, a thermostat) have given the disks since
+        the start, J (negative: the heat they took; 0 for a magnetic field)."""
+        return float(self.tally.forces[0])
+
     def escaped(self) -> int:
         """Number of particles outside the vessel (always 0 unless something is badly wrong)."""
         p = self.particles
@@ -516,6 +521,7 @@ class Simulation:
             "collisions": {"pair": c.pair_collisions, "wall": c.wall_collisions},
             "wall_heat": self.wall_heat(),
             "collision_heat": self.collision_heat(),
+            "force_heat": self.force_heat(),
             "escaped": self.escaped(),
         }
         piston = self.piston()
@@ -539,6 +545,7 @@ class Simulation:
             "position": p.position, "velocity": p.velocity, "image": p.image,
             "tally/counts": self.tally.counts, "tally/impulse": self.tally.impulse,
             "tally/heat": self.tally.heat, "tally/piston": self.tally.piston,
+            "tally/forces": self.tally.forces,
         } | properties | drift | integrator  # fmt: skip
         state = {
             "name": self.name,
@@ -616,8 +623,8 @@ def restore_with_meta(path: str | Path) -> tuple[Simulation, dict[str, Any]]:
         sim.rng.bit_generator.state = state["rng"]
         # Tallies of checkpoints made before vessels had their own number of walls held five
         # entries, the walls' first.
-        for name in ("counts", "impulse", "heat", "piston"):
-            if f"tally/{name}" in arrays:  # heat is absent from those made before thermal walls
+        for name in ("counts", "impulse", "heat", "piston", "forces"):
+            if f"tally/{name}" in arrays:  # absent from those made before thermal walls, forces
                 tally = getattr(sim.tally, name)
                 tally[...] = arrays[f"tally/{name}"][: tally.size]
         sim._drift.load_state(

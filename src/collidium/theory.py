@@ -163,3 +163,15 @@ def projectile_range(speed: float, drop: float, acceleration: float) -> float:
     """How far (m) a body launched level at ``speed`` (m/s) travels while it falls ``drop`` m
     under a constant ``acceleration`` (m/s^2): ``speed sqrt(2 drop / acceleration)``."""
     return speed * math.sqrt(2.0 * drop / acceleration)
+
+
+def cyclotron_radius(mass: float, speed: float, charge: float, field: float) -> float:
+    """Radius (m) of the circle a charge (C) of ``mass`` (kg) moving at ``speed`` (m/s) runs in a
+    magnetic ``field`` (T) normal to its velocity: ``m v / (|q| B)``."""
+    return mass * speed / abs(charge * field)
+
+
+def terminal_velocity(mass: float, g: float, gamma: float) -> float:
+    """Speed (m/s) at which linear drag ``gamma`` (kg/s) balances the weight ``m g``:
+    ``m g / gamma``."""
+    return mass * g / gamma

@@ -7,8 +7,22 @@ import numpy as np
 import pytest
 
 import collidium as cd
-from collidium import Box, Coulomb, Gravity, InputError, Newton, Particles, UniformField
-from collidium.forces import FORCES, ForceField, force_from_dict
+from collidium import (
+    Box,
+    Coulomb,
+    FieldMap,
+    Friction,
+    Gravity,
+    InputError,
+    Langevin,
+    LinearDrag,
+    MagneticField,
+    Newton,
+    Particles,
+    QuadraticDrag,
+    UniformField,
+)
+from collidium.forces import FORCES, ForceField, PositionForce, VelocityForce, force_from_dict
 from collidium.scenario import Scenario
 
 #: One example of each registered force, with parameters away from their defaults.
@@ -17,7 +31,22 @@ EXAMPLES = {
     "newton": Newton(G=2.0, softening=0.1, method="direct"),
     "gravity": Gravity(g=(1.5, -9.81)),
     "uniform_field": UniformField(E=(3.0, -2.0)),
+    "field_map": FieldMap.sample(
+        lambda x, y: 0.3 * x * y - 0.05 * x**2 + np.sin(y / 3), ((-10, -10), (10, 10)), (9, 11)
+    ),
+    "magnetic_field": MagneticField(B=0.7),
+    "linear_drag": LinearDrag(gamma=0.3),
+    "quadratic_drag": QuadraticDrag(c=0.05),
+    "friction": Friction(mu=0.1, g=2.0),
+    "langevin": Langevin(temperature=3.0, gamma=0.5),
 }
+POSITION_FORCES = sorted(n for n, f in EXAMPLES.items() if isinstance(f, PositionForce))
+
+
+def test_every_force_acts_on_positions_or_velocities():
+    for force in EXAMPLES.values():
+        assert isinstance(force, PositionForce) != isinstance(force, VelocityForce)
+    assert POSITION_FORCES == ["coulomb", "field_map", "gravity", "newton", "uniform_field"]
 
 
 def test_every_registered_force_has_an_example():
@@ -33,7 +62,7 @@ def _scattered(periodic: bool = False) -> tuple[Particles, Box]:
     return particles, Box(20, 20, "periodic" if periodic else "reflecting")
 
 
-@pytest.mark.parametrize("name", sorted(EXAMPLES))
+@pytest.mark.parametrize("name", POSITION_FORCES)
 def test_force_is_minus_the_gradient_of_its_potential(name):
     """Central differences of the potential, step h = 1e-5 m: truncation ~ h^2 U''' and
     round-off ~ 1e-16 U / h, both below 1e-8 of the largest force here."""
@@ -61,10 +90,12 @@ def test_pair_forces_sum_to_zero(name):
 
 
 def test_forces_add_up():
-    """A charged massive gas under all four: the field's acceleration is the sum of each's."""
+    """A charged massive gas under all position forces: the field's acceleration is the sum of
+    each's."""
     particles, box = _scattered()
-    together = ForceField(tuple(EXAMPLES.values())).evaluate(particles, box).copy()
-    apart = sum(ForceField((f,)).evaluate(particles, box) for f in EXAMPLES.values())
+    forces = [EXAMPLES[name] for name in POSITION_FORCES]
+    together = ForceField(tuple(forces)).evaluate(particles, box).copy()
+    apart = sum(ForceField((f,)).evaluate(particles, box) for f in forces)
     np.testing.assert_allclose(together, apart, rtol=1e-13, atol=1e-13 * np.abs(apart).max())
 
 
@@ -89,7 +120,7 @@ def test_a_force_is_its_table(name):
 
 
 def test_scenario_files_and_checkpoints_carry_every_force(tmp_path):
-    """A scene under all four forces: exported to TOML and read back it has the same forces;
+    """A scene under every force: exported to TOML and read back it has the same forces;
     saved and restored, it runs on bit for bit as the original."""
     particles, _ = _scattered()
     particles.radius = 0.1

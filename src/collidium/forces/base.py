@@ -24,7 +24,9 @@ from collidium.vessels import Vessel
 
 @runtime_checkable
 class Force(Protocol):
-    """What the integrators and front ends ask of a force (a frozen dataclass of parameters).
+    """What every force is to the front ends (a frozen dataclass of parameters): a name, a check
+    of the set-up and a table. It acts either on the positions (`PositionForce`) or on the
+    velocities (`VelocityForce`).
 
     Attributes
     ----------
@@ -36,6 +38,14 @@ class Force(Protocol):
 
     def check(self, particles: Particles, vessel: Vessel) -> None:
         """Refuse a set-up this force cannot act in (`InputError` naming the field)."""
+
+    def to_dict(self) -> dict[str, object]:
+        """The parameters as a scenario table, with ``type`` = `name`."""
+
+
+@runtime_checkable
+class PositionForce(Force, Protocol):
+    """A force of the positions, with a potential energy: the kicks of kick-drift-kick."""
 
     def compute(
         self,
@@ -56,8 +66,23 @@ class Force(Protocol):
         by about ``sqrt(S) h^2`` (`collidium.integrators`); 0 for a uniform force, which leapfrog
         follows exactly. ``acceleration`` (N, 2) is the total of the last evaluation."""
 
-    def to_dict(self) -> dict[str, object]:
-        """The parameters as a scenario table, with ``type`` = `name`."""
+
+@runtime_checkable
+class VelocityForce(Force, Protocol):
+    """A force of the velocities (a magnetic field, drag, friction, a thermostat), with no
+    potential: the integrators apply its exact flow on the velocities for half a substep before
+    each kick-drift-kick and half after (a time-symmetric splitting; `ForceField.advance`)."""
+
+    def advance(
+        self, particles: Particles, vessel: Vessel, h: float, rng: np.random.Generator
+    ) -> float:
+        """Change the velocities in place as the force alone would in ``h`` seconds; returns the
+        energy that gave the particles, J (negative for drag: the heat it took)."""
+
+    def rate(self, particles: Particles, vessel: Vessel) -> float:
+        """The fastest rate at which the force turns or damps a velocity, 1/s (``|q B| / m``,
+        ``gamma / m``): the adaptive integrator keeps a substep within ``tolerance`` of its
+        inverse; 0 where the flow is exact whatever the substep."""
 
 
 #: Every force by its name (filled as the force modules are imported).
@@ -105,7 +130,13 @@ def force_from_dict(data: Mapping[str, Any], where: str = "forces") -> Force:
     try:
         return cls(**{key: value for key, value in data.items() if key != "type"})
     except InputError as exc:
-        raise InputError(f"{where}.{exc.field.rsplit('.', 1)[-1]}", exc.reason) from None
+        raise InputError(f"{where}.{parameter_path(exc)}", exc.reason) from None
+
+
+def parameter_path(error: InputError) -> str:
+    """The parameter a force's own check named (``potential.1.1`` of
+    ``forces.field_map.potential.1.1``), to put under the force's place in a list."""
+    return error.field.split(".", 2)[-1]
 
 
 # --- parameter checks shared by the forces -----------------------------------------------------
@@ -137,6 +168,26 @@ def check_vector(force: str, field: str, value: Any) -> tuple[float, float]:
     return x, y
 
 
+def check_rectangle(
+    force: str, field: str, value: Any
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Two finite corners (lower left, upper right) as tuples, the second above and right of
+    the first."""
+    try:
+        low, high = value
+    except (TypeError, ValueError):
+        raise InputError(
+            f"forces.{force}.{field}", f"must be two corners [[x0, y0], [x1, y1]], got {value!r}"
+        ) from None
+    low, high = check_vector(force, field, low), check_vector(force, field, high)
+    if not (low[0] < high[0] and low[1] < high[1]):
+        raise InputError(
+            f"forces.{force}.{field}", f"the second corner must be above and right of the "
+            f"first, got {value!r}"
+        )  # fmt: skip
+    return low, high
+
+
 def _refuse_infinite(acceleration: FloatArray) -> None:
     """One line naming the first particle whose acceleration (N, 2) overflowed (a force on a
     mass too small to move by it)."""
@@ -152,17 +203,23 @@ def _refuse_infinite(acceleration: FloatArray) -> None:
 
 
 class ForceField:
-    """All forces of a simulation: total acceleration and potential energy, with reused buffers.
+    """All forces of a simulation: total acceleration and potential energy of the position
+    forces, with reused buffers, and the flow of the velocity forces.
 
     Parameters
     ----------
     forces : sequence of Force
         The forces acting; empty for free flight.
+    rng : numpy.random.Generator, optional
+        Where a thermostat draws its kicks (the simulation's generator, saved in checkpoints).
     """
 
-    def __init__(self, forces: tuple[Force, ...]) -> None:
+    def __init__(self, forces: tuple[Force, ...], rng: np.random.Generator | None = None) -> None:
         self.forces = tuple(forces)
-        self._work: list[dict[str, np.ndarray]] = [{} for _ in self.forces]
+        self._position = tuple(f for f in self.forces if isinstance(f, PositionForce))
+        self._velocity = tuple(f for f in self.forces if isinstance(f, VelocityForce))
+        self._rng = np.random.default_rng() if rng is None else rng
+        self._work: list[dict[str, np.ndarray]] = [{} for _ in self._position]
         self._force = np.empty((0, 2))
         self._energy = np.empty(0)
         self._virial = np.empty(0)
@@ -182,8 +239,8 @@ class ForceField:
         return bool(self.forces)
 
     def evaluate(self, particles: Particles, vessel: Vessel) -> FloatArray:
-        """Total acceleration (N, 2) in m/s^2 at the current positions; also caches the potential
-        and the virial."""
+        """Total acceleration (N, 2) in m/s^2 of the position forces at the current positions;
+        also caches the potential and the virial."""
         n = particles.n
         if self._force.shape[0] != n:
             self._force = np.empty((n, 2))
@@ -192,7 +249,7 @@ class ForceField:
             self._acceleration = np.empty((n, 2))
         self._acceleration[...] = 0.0
         potential = virial = 0.0
-        for force, work in zip(self.forces, self._work, strict=True):
+        for force, work in zip(self._position, self._work, strict=True):
             force.compute(particles, vessel, self._force, self._energy, self._virial, work)
             self._acceleration += self._force
             potential += float(np.sum(self._energy))
@@ -207,11 +264,22 @@ class ForceField:
 
     def stiffness(self, particles: Particles, vessel: Vessel) -> float:
         """``S`` of all forces at the current state, in J^2/s^4: the largest of the forces'
-        (`Force.stiffness`, given the acceleration of the last `evaluate`)."""
+        (`PositionForce.stiffness`, given the acceleration of the last `evaluate`)."""
         return max(
-            (force.stiffness(particles, vessel, self._acceleration) for force in self.forces),
+            (force.stiffness(particles, vessel, self._acceleration) for force in self._position),
             default=0.0,
         )
+
+    def rate(self, particles: Particles, vessel: Vessel) -> float:
+        """The fastest rate of the velocity forces, 1/s (`VelocityForce.rate`; 0 without)."""
+        return max((force.rate(particles, vessel) for force in self._velocity), default=0.0)
+
+    def advance(self, particles: Particles, vessel: Vessel, h: float, first: bool) -> float:
+        """Apply the velocity forces for ``h`` seconds, one after the other: in reverse order
+        for the ``first`` half of a substep and in order for the second, so that the substep is
+        time-symmetric. Returns the energy they gave the particles, J."""
+        forces = reversed(self._velocity) if first else self._velocity
+        return sum((force.advance(particles, vessel, h, self._rng) for force in forces), 0.0)
 
     def potential(self, particles: Particles, vessel: Vessel) -> float:
         """Potential energy in J at the current positions (cached from the last evaluation)."""

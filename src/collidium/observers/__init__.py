@@ -14,6 +14,7 @@ from collidium.observers.paths import Tracer
 from collidium.observers.profile import TemperatureProfile
 from collidium.observers.speeds import SpeedHistogram
 from collidium.observers.thermo import Thermo
+from collidium.observers.virial import VirialRatio
 
 __all__ = [
     "After",
@@ -30,4 +31,5 @@ __all__ = [
     "Thermo",
     "Tracer",
     "Trigger",
+    "VirialRatio",
 ]

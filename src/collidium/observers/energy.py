@@ -166,9 +166,8 @@ def drift_warning(drift: float, limit: float = DRIFT_WARNING) -> str | None:
 class EnergyDrift(Measurement):
     """Largest relative change of the total energy during a run, without storing a series.
 
-    What is conserved is the total energy less what the walls have given the disks (thermal and
-    inelastic walls, `collidium.simulation.Simulation.wall_heat`; nothing for mirrors), so that
-    is what is measured.
+    What is conserved is the total energy less what the walls, collisions and velocity forces
+    have given the disks (`conserved_energy`), so that is what is measured.
 
     Parameters
     ----------
@@ -183,7 +182,7 @@ class EnergyDrift(Measurement):
     initial_total : float
         The reference energy in J (less the walls' heat until then).
     max_rel_drift : float
-        ``max |E(t) - Q(t) - E_ref| / |E_ref|`` over the samples, Q the walls' heat.
+        ``max |E(t) - Q(t) - E_ref| / |E_ref|`` over the samples, Q the heat given.
     """
 
     def __init__(
@@ -210,9 +209,10 @@ class EnergyDrift(Measurement):
 
 
 def conserved_energy(sim: Simulation, energy: Energy | None = None) -> float:
-    """The total energy less the energy the walls and inelastic collisions have given the disks
-    since the start, J: what the dynamics conserve (the total energy itself with mirror walls
-    and elastic disks). ``energy``: `Simulation.energy` now, if the caller has it already (the
-    pair sum is O(N^2))."""
+    """The total energy less the energy the walls, inelastic collisions and velocity forces (drag,
+    a thermostat) have given the disks since the start, J: what the dynamics conserve (the total
+    energy itself with mirror walls, elastic disks and no velocity forces). ``energy``:
+    `Simulation.energy` now, if the caller has it already (the pair sum is O(N^2))."""
     total = (sim.energy() if energy is None else energy).total
-    return total - float(sum(sim.wall_heat().values())) - sim.collision_heat()
+    given = sum(sim.wall_heat().values()) + sim.collision_heat() + sim.force_heat()
+    return total - float(given)

@@ -131,6 +131,22 @@ GUIDES: dict[str, Guide] = {
         "a constant force, so it falls on a parabola, like a thrown ball, and bounces.",
         colour="charge",
     ),
+    "spectrometer": Guide(
+        "Three ions with the same charge and speed but different masses fly into a magnetic "
+        "field. It turns each on a half circle whose radius grows with the mass, r = m v / (q B), "
+        "so they come down and land apart: the heavier, the further.",
+        colour="charge",
+    ),
+    "galaxy": Guide(
+        "Thousands of disks pull on each other by gravity. Starting too slow to hold themselves "
+        "up, they fall together, overshoot and settle into a round cluster, where the kinetic "
+        "energy is half the depth of the potential energy (the virial theorem)."
+    ),
+    "drag": Guide(
+        "Three disks of different masses fall through a fluid. Drag grows with speed until it "
+        "balances the weight: each then falls at its terminal velocity m g / gamma, the "
+        "heaviest the fastest."
+    ),
 }
 
 #: Label and unit of the parameters the page offers, by name (unknown ones show their name).
@@ -157,6 +173,9 @@ PARAMETER_LABELS: dict[str, tuple[str, str]] = {
     "start": ("piston starts at", "m"),
     "columns": ("columns", ""),
     "rows": ("rows", ""),
+    "g": ("gravity g", "m/s²"),
+    "gamma": ("drag γ", "kg/s"),
+    "G": ("G", "N m²/kg²"),
 }
 #: The values a parameter given as a word may take.
 CHOICES: dict[str, tuple[str, ...]] = {
