@@ -549,9 +549,9 @@ def test_version_and_help_without_flag_types_or_empty_brackets(capsys):
         assert "<bool>" not in shown and "()" not in shown, shown
 
 
-def test_a_few_bodies_get_no_temperature_or_maxwell_boltzmann_test():
+def test_a_few_bodies_get_no_temperature_compressibility_or_maxwell_boltzmann_test():
     table = collidium("run", "orbit", "--time", "1").stdout
-    assert table.count("n/a (2 particles, not a gas)") == 2
+    assert table.count("n/a (2 particles, not a gas)") == 3
     summary = json.loads(collidium("run", "orbit", "--time", "1", "--json").stdout)
     assert summary["ks_pvalue"] is None and summary["temperature"] > 0  # kT = KE/N is defined
 

@@ -578,7 +578,9 @@ def _print_summary(summary: dict[str, Any]) -> None:
         ("virial pressure", _number(pressure["virial"], "N/m", pressure["virial_error"])),
         (
             "compressibility Z = PA/NkT",
-            _number(summary["compressibility"], "", summary["compressibility_error"]),
+            _for_a_gas(
+                summary, _number(summary["compressibility"], "", summary["compressibility_error"])
+            ),
         ),
         ("Maxwell-Boltzmann KS p-value", _for_a_gas(summary, _number(summary["ks_pvalue"], ""))),
         ("escaped", f"{summary['escaped']}"),
