@@ -27,10 +27,10 @@ def max_drift(sim: cd.Simulation, time: float) -> float:
 # The targets at each preset's defaults (dt = 0.01 s): (preset, seconds, bound). The
 # charged gas is held to its bound over 2 s here (60 s take minutes; the benchmark runs them).
 TARGETS = [
-    ("orbit", 60.0, 1e-6),
-    ("charged-like", 60.0, 1e-6),
-    ("charged-opposite", 60.0, 1e-6),
-    ("charged-no-collisions", 20.0, 1e-5),
+    pytest.param("orbit", 60.0, 1e-6, marks=pytest.mark.slow),
+    pytest.param("charged-like", 60.0, 1e-6, marks=pytest.mark.slow),
+    pytest.param("charged-opposite", 60.0, 1e-6, marks=pytest.mark.slow),
+    pytest.param("charged-no-collisions", 20.0, 1e-5, marks=pytest.mark.slow),
     pytest.param("bohr-atom", 20.0, 1e-5, marks=pytest.mark.slow),
     pytest.param("charged-gas", 2.0, 1e-5, marks=pytest.mark.slow),
 ]

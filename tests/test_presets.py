@@ -423,6 +423,7 @@ def test_effusion_starts_both_masses_in_the_left_chamber_at_one_temperature():
     assert sim.container.partition("divider").gap == 2.0 and start[0] == end[0] == 0.0
 
 
+@pytest.mark.slow
 def test_effusion_follows_grahams_law_and_the_lighter_escapes_faster():
     """Graham: per-disk crossing rates in the ratio sqrt(m2/m1) = 2, within 5%; the run counts
     some 14000 and 7000 crossings, so 5% is over 3 standard errors of the ratio. Disks of
@@ -542,6 +543,7 @@ def test_galaxy_settles_to_virial_equilibrium():
     assert 0.8 < virial.summary()["bound_fraction"] < 1.0
 
 
+@pytest.mark.slow
 def test_atmosphere_follows_the_barometric_law_where_dilute():
     """A smaller atmosphere (400 disks, 20 m x 40 m, kT about 16 J, scale height kT / (m g)
     about 16 m), relaxed for 40 s and measured over 200 s in 10 slices. In the upper half

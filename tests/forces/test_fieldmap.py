@@ -62,6 +62,7 @@ def _energy_error(tolerance: float) -> float:
     return worst
 
 
+@pytest.mark.slow
 def test_the_energy_error_falls_at_least_as_the_substep():
     """The force of a bilinear map jumps at grid lines, and a substep across one errs on the
     energy by O(h), not O(h^2): a quarter of the tolerance (substeps 4x shorter) cuts the

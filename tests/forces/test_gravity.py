@@ -54,6 +54,7 @@ def _binary(speed: float) -> cd.Simulation:
     return cd.Simulation(Box(20, 20), particles, forces=[Newton(G=1.0)], collisions="off")
 
 
+@pytest.mark.slow
 def test_an_eccentric_binary_holds_its_energy_as_the_time_stepping_targets():
     """An ellipse of eccentricity 0.36 (apocentre 2 m, pericentre 0.94 m), 20 s: within the
     1e-6 that the accurate time stepping holds for the seed's orbit."""

@@ -83,6 +83,7 @@ def test_wall_and_virial_pressure_agree_in_a_dense_fluid():
         assert abs(wall[name] - wall["total"]) < 4 * 2 * thermo.wall_pressure_error()
 
 
+@pytest.mark.slow
 def test_wall_and_virial_pressure_agree_with_coulomb_forces():
     sim = cd.load("charged-gas", seed=3).run(time=5.0)
     thermo = measure(sim, 25.0)
