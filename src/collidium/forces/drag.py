@@ -12,7 +12,7 @@ from typing import ClassVar
 import numpy as np
 
 from collidium.forces.base import check_at_least, register
-from collidium.forces.velocity import scale_speeds, speeds
+from collidium.forces.velocity import damping_rate, scale_speeds, speeds
 from collidium.state import Particles
 from collidium.vessels import Vessel
 
@@ -47,7 +47,7 @@ class LinearDrag:
 
     def rate(self, particles: Particles, vessel: Vessel) -> float:
         """``gamma / m`` of the lightest particle, 1/s."""
-        return float(self.gamma / np.min(particles.mass, initial=np.inf))
+        return damping_rate(self.gamma, particles)
 
     def to_dict(self) -> dict[str, object]:
         """Parameters as in a scenario file."""

@@ -46,9 +46,11 @@ class FieldMap:
     potential: tuple[tuple[float, ...], ...]
     region: tuple[tuple[float, float], tuple[float, float]] | None = None
     _grid: FloatArray = field(init=False, repr=False, compare=False)
+    _bends: FloatArray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "_grid", _grid(self.potential))
+        object.__setattr__(self, "_bends", _bends(self._grid))
         object.__setattr__(self, "potential", tuple(tuple(row) for row in self._grid.tolist()))
         if self.region is not None:
             object.__setattr__(self, "region", check_rectangle(self.name, "region", self.region))
@@ -92,15 +94,10 @@ class FieldMap:
         """``S`` (J^2/s^4) from each charge's speed over the grid's sharpest bend ``kappa``
         (V/m^2, its largest second difference) and its acceleration:
         ``(|q| kappa v^2 + m |a|^2)^2`` at most."""
-        spacing = self._spacing(vessel)
-        grid = self._grid
-        bends = [
-            np.abs(np.diff(grid, 2, axis=1)).max(initial=0.0) / spacing[0] ** 2,
-            np.abs(np.diff(grid, 2, axis=0)).max(initial=0.0) / spacing[1] ** 2,
-            np.abs(np.diff(np.diff(grid, axis=0), axis=1)).max() / (spacing[0] * spacing[1]),
-        ]
+        dx, dy = self._spacing(vessel)
+        bend = float(np.max(self._bends / np.array([dx * dx, dy * dy, dx * dy])))
         v, a = particles.velocity, acceleration
-        error = np.abs(particles.charge) * max(bends) * np.einsum("ij,ij->i", v, v)
+        error = np.abs(particles.charge) * bend * np.einsum("ij,ij->i", v, v)
         error += particles.mass * np.einsum("ij,ij->i", a, a)
         return float(np.max(error * error, initial=0.0))
 
@@ -144,6 +141,16 @@ class FieldMap:
         slope_x = np.where(inside_u, (1 - fw) * (p10 - p00) + fw * (p11 - p01), 0.0) / spacing[0]
         slope_y = np.where(inside_w, top - bottom, 0.0) / spacing[1]
         return phi, slope_x, slope_y
+
+
+def _bends(grid: FloatArray) -> FloatArray:
+    """The grid's largest second differences along x, along y and across, V (made once: the
+    substeps ask for them at every boundary)."""
+    return np.array([
+        np.abs(np.diff(grid, 2, axis=1)).max(initial=0.0),
+        np.abs(np.diff(grid, 2, axis=0)).max(initial=0.0),
+        np.abs(np.diff(np.diff(grid, axis=0), axis=1)).max(),
+    ])  # fmt: skip
 
 
 def _grid(potential: Any) -> FloatArray:

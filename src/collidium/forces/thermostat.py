@@ -9,6 +9,7 @@ import numpy as np
 
 from collidium.errors import InputError
 from collidium.forces.base import check_at_least, check_finite, register
+from collidium.forces.velocity import damping_rate
 from collidium.state import Particles
 from collidium.vessels import Vessel
 
@@ -65,7 +66,7 @@ class Langevin:
 
     def rate(self, particles: Particles, vessel: Vessel) -> float:
         """``gamma / m`` of the lightest particle, 1/s."""
-        return float(self.gamma / np.min(particles.mass, initial=np.inf))
+        return damping_rate(self.gamma, particles)
 
     def to_dict(self) -> dict[str, object]:
         """Parameters as in a scenario file."""

@@ -17,6 +17,12 @@ def speeds(particles: Particles) -> FloatArray:
     return np.hypot(particles.velocity[:, 0], particles.velocity[:, 1])
 
 
+def damping_rate(gamma: float, particles: Particles) -> float:
+    """``gamma / m`` of the lightest particle, 1/s: the fastest rate at which a drag
+    coefficient ``gamma`` (kg/s) damps a velocity."""
+    return float(gamma / np.min(particles.mass, initial=np.inf))
+
+
 def scale_speeds(particles: Particles, factor: FloatArray) -> float:
     """Multiply each velocity by ``factor`` (N,) in place; returns the kinetic energy this gave
     the particles, J (negative: what it took)."""
