@@ -26,6 +26,7 @@ TABLE = segment_table(np.array([[-1.0, -2.0], [0.5, 0.5]]), np.array([[3.0, 1.0]
     st.one_of(st.just(0.0), st.floats(1e-3, 0.8)), st.sampled_from([0, 1]),
 )  # fmt: skip
 @example(0.0, 0.0, 0.0, 17.0, 0.5, 1)  # a path tangent to the point: the kernel touches
+@example(-2.875, 0.0, 0.0, 1.0, 0.5, 1)  # tangent to the point 3.4 m ahead: a double root
 def test_element_delay_equals_its_twin_and_ends_a_radius_away(x, y, heading, speed, r, e):
     start = np.array([x, y])
     if distances(start[None], TABLE[e : e + 1])[0, 0] <= r:
@@ -47,10 +48,12 @@ def test_element_delay_equals_its_twin_and_ends_a_radius_away(x, y, heading, spe
             _, _, nx, ny = touch(*at, *velocity, r, TABLE, e)
             assert abs(velocity @ [nx, ny]) <= 1e-6 * speed
         return
-    # A linear or quadratic root: equal to round-off relative to the time to cross 12 m; near
-    # a graze of a point the root is nearly double and carries the square root of the relative
-    # round-off (1e-8) of the time to cross the disk.
-    assert abs(delay - twin) <= 1e-11 * (1.0 + 12.0 / speed) + 1e-7 * r / speed
+    # A linear or quadratic root: equal to round-off relative to the time to cross 12 m. Near a
+    # graze of a point the root is nearly double: the discriminant b^2 - 4ac cancels to round-off
+    # of b^2, whose square root leaves sqrt(eps) of the time to reach the point (an end).
+    reach = max(math.dist(start, TABLE[e, :2]), math.dist(start, TABLE[e, 2:4])) + r
+    graze = 4.0 * math.sqrt(np.finfo(float).eps) * reach
+    assert abs(delay - twin) <= 1e-11 * (1.0 + 12.0 / speed) + graze / speed
     at = start + velocity * delay
     assert abs(distances(at[None], TABLE[e : e + 1])[0, 0] - r) <= 1e-10
     cx, cy, nx, ny = touch(*at, *velocity, r, TABLE, e)
