@@ -268,6 +268,47 @@ def test_parse_settings_reads_toml_values():
     assert type(values["n"]) is int and type(values["k"]) is float
 
 
+class _Terminal:
+    """A stderr that says it is a terminal, keeping what is written."""
+
+    def __init__(self) -> None:
+        self.text = ""
+
+    def write(self, text: str) -> None:
+        self.text += text
+
+    def flush(self) -> None:
+        pass
+
+    def isatty(self) -> bool:
+        return True
+
+
+@pytest.mark.parametrize("quiet", [False, True])
+def test_a_first_compile_is_announced_once_at_a_terminal(monkeypatch, quiet):
+    """numba's cache is warm here, so a compilation is made: a fresh kernel compiled while the
+    command loads its scenario."""
+    import numba
+
+    import collidium.loading
+    from collidium.cli import main
+
+    load = collidium.loading.load_scenario
+
+    def compile_then_load(source, **overrides):
+        numba.njit(lambda x: x + 1)(1)
+        numba.njit(lambda x: x + 2)(1)
+        return load(source, **overrides)
+
+    terminal = _Terminal()
+    monkeypatch.setattr(collidium.loading, "load_scenario", compile_then_load)
+    monkeypatch.setattr(sys, "stderr", terminal)
+    # --json: no progress bar on the terminal beside the notice
+    assert main(["run", "head-on", "--steps", "1", "--json", *(["-q"] if quiet else [])]) == 0
+    notice = "compiling kernels (first run only)...\n"
+    assert terminal.text == ("" if quiet else notice)
+
+
 def test_failed_run_gives_one_line_and_exit_1(monkeypatch, capsys):
     import collidium.loading
     from collidium.cli import main

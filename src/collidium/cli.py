@@ -12,6 +12,7 @@ import sys
 import tomllib
 import warnings
 from collections.abc import Sequence
+from contextlib import nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -19,6 +20,7 @@ import typer
 from pydantic import ValidationError
 
 from collidium.errors import InputError, Interrupted, SimulationError
+from collidium.kernels.compilation import on_first_compile
 
 if TYPE_CHECKING:
     from collidium.runner import Job
@@ -721,17 +723,28 @@ def _flags_without_type(command: Any) -> None:
         _flags_without_type(subcommand)
 
 
+def _compiling_notice() -> None:
+    """Say at once why a first run is silent for a while."""
+    sys.stderr.write("compiling kernels (first run only)...\n")
+    sys.stderr.flush()
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Console entry point. Returns the exit status (0 ok, 1 failed run, 2 bad input)."""
     click_exception, usage_error = _click_exceptions()
     command = typer.main.get_command(app)
     _flags_without_type(command)
+    args = list(sys.argv[1:] if argv is None else argv)
+    # Like the progress bar, for a person at a terminal; --quiet says nothing but warnings.
+    quiet = "--quiet" in args or "-q" in args or not sys.stderr.isatty()
+    notice = nullcontext() if quiet else on_first_compile(_compiling_notice)
     try:
-        result = command.main(
-            args=list(sys.argv[1:] if argv is None else argv),
-            prog_name="collidium",
-            standalone_mode=False,
-        )
+        with notice:
+            result = command.main(
+                args=args,
+                prog_name="collidium",
+                standalone_mode=False,
+            )
     except InputError as exc:
         return _fail(str(exc), 2)
     except ValidationError as exc:
