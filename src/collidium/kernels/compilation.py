@@ -11,21 +11,21 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-from numba.core import event
+from numba.core import event as numba_event
 
 
-class _FirstCompile(event.Listener):
+class _FirstCompile(numba_event.Listener):
     """Calls its callback at the start of the first compilation it hears of, once."""
 
     def __init__(self, callback: Callable[[], None]) -> None:
         self.callback: Callable[[], None] | None = callback
 
-    def on_start(self, event: event.Event) -> None:
+    def on_start(self, event: numba_event.Event) -> None:
         callback, self.callback = self.callback, None
         if callback is not None:
             callback()
 
-    def on_end(self, event: event.Event) -> None:
+    def on_end(self, event: numba_event.Event) -> None:
         pass
 
 
@@ -34,8 +34,8 @@ def on_first_compile(callback: Callable[[], None]) -> Iterator[None]:
     """Within the block, call ``callback()`` (no arguments) once, when numba first compiles a
     kernel rather than loading it from its cache; never if every kernel comes from the cache."""
     listener = _FirstCompile(callback)
-    event.register("numba:compile", listener)
+    numba_event.register("numba:compile", listener)
     try:
         yield
     finally:
-        event.unregister("numba:compile", listener)
+        numba_event.unregister("numba:compile", listener)
