@@ -286,8 +286,8 @@ class _Terminal:
 
 @pytest.mark.parametrize("quiet", [False, True])
 def test_a_first_compile_is_announced_once_at_a_terminal(monkeypatch, quiet):
-    """numba's cache is warm here, so a compilation is made: a fresh kernel compiled while the
-    command loads its scenario."""
+    """A first run, made here (the suite's cache is warm) by compiling two fresh kernels while
+    the command loads its scenario: one notice for both, none with --quiet."""
     import numba
 
     import collidium.loading
