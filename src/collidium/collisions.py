@@ -108,7 +108,17 @@ class Contact:
 
 
 class Drift(Protocol):
-    """A drift mode: moves particles over one step and counts collisions."""
+    """A drift mode: moves particles over one step and counts collisions.
+
+    Attributes
+    ----------
+    carries_fall : bool
+        Whether the mode's free flight is a parabola under a uniform acceleration that every
+        particle shares (`collidium.forces.base.ForceField.fall`): such a force then gives no
+        kicks.
+    """
+
+    carries_fall: bool
 
     def drift(
         self,
@@ -119,11 +129,14 @@ class Drift(Protocol):
         tally: Tally,
         acceleration: FloatArray | None = None,
         halt_after: float = math.inf,
+        fall: FloatArray | None = None,
     ) -> Contact | None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place, adding to ``tally``.
 
         ``acceleration`` (N, 2), in m/s^2, is that of the step's half kicks when forces act; a mode
-        may use it to time collisions within the step consistently with the kicks.
+        may use it to time collisions within the step consistently with the kicks. ``fall``
+        (2,), in m/s^2, is the acceleration every particle flies under between kicks (zero for
+        a mode that does not `carries_fall`).
 
         A mode with exact contact times stops at the first wall hit of a particle with a
         non-zero acceleration, or collision of two with different accelerations, after
@@ -160,6 +173,7 @@ def make_drift(mode: CollisionMode, restitution: float = 1.0) -> Drift:
 
 
 _NO_ACCELERATION = np.empty((0, 2))
+_NO_FALL = np.zeros(2)
 
 
 def _free_flight(particles: Particles, vessel: Vessel, dt: float, tally: Tally) -> None:
@@ -176,13 +190,16 @@ def _free_flight(particles: Particles, vessel: Vessel, dt: float, tally: Tally) 
 MAX_CROSSINGS_PER_DRIFT = 1e9
 
 
-def _refuse_runaway(particles: Particles, vessel: Vessel, dt: float) -> None:
-    """Stop before an event-driven drift whose event count would be astronomical."""
+def _refuse_runaway(
+    particles: Particles, vessel: Vessel, dt: float, fall: FloatArray = _NO_FALL
+) -> None:
+    """Stop before an event-driven drift whose event count would be astronomical (a fall of
+    ``fall`` m/s^2 adds its speed after dt)."""
     if particles.n == 0:
         return
     velocity = particles.velocity
     # Reductions only: an (N, 2) temporary would add 16 bytes per disk to the peak memory.
-    speed = max(float(velocity.max()), -float(velocity.min()))
+    speed = max(float(velocity.max()), -float(velocity.min())) + float(np.abs(fall).max()) * dt
     if speed * dt > MAX_CROSSINGS_PER_DRIFT * float(vessel.size.min()):
         fastest = int(np.abs(velocity).max(axis=1).argmax())
         raise SimulationError(
@@ -192,7 +209,10 @@ def _refuse_runaway(particles: Particles, vessel: Vessel, dt: float) -> None:
 
 
 class _Stateless:
-    """A mode whose drift depends on the particles alone (work arrays are rebuilt identically)."""
+    """A mode whose drift depends on the particles alone (work arrays are rebuilt identically)
+    and flies straight between kicks."""
+
+    carries_fall = False
 
     def state(self) -> dict[str, np.ndarray]:
         """Nothing to save."""
@@ -217,6 +237,7 @@ class NoCollisions(_Stateless):
         tally: Tally,
         acceleration: FloatArray | None = None,
         halt_after: float = math.inf,
+        fall: FloatArray | None = None,
     ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place (never halts)."""
         _free_flight(particles, vessel, dt, tally)
@@ -316,6 +337,7 @@ class StepCollisions(_Stateless):
         tally: Tally,
         acceleration: FloatArray | None = None,
         halt_after: float = math.inf,
+        fall: FloatArray | None = None,
     ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place (never halts)."""
         _free_flight(particles, vessel, dt, tally)
@@ -359,8 +381,11 @@ class ExactCollisions:
     The engine keeps lazily updated positions of its own, in its own order
     (`collidium.kernels.events`); ``particles.position`` and ``particles.velocity`` receive the
     state at the end of each drift. If the particles differ from what the engine last wrote (a
-    force kick, an edit by the user), the queue is rebuilt from them.
+    force kick, an edit by the user), the queue is rebuilt from them. Under a uniform gravity
+    the free flights are exact parabolas (`carries_fall`), so the queue lives on then too.
     """
+
+    carries_fall = True
 
     def __init__(self, restitution: float = 1.0) -> None:
         #: Normal restitution of the pair collisions (1: elastic).
@@ -410,9 +435,11 @@ class ExactCollisions:
         if self._state is not None:
             self._spare, self._state = self._state, None
 
-    def _is_current(self, particles: Particles, piston: FloatArray) -> bool:
+    def _is_current(self, particles: Particles, piston: FloatArray, fall: FloatArray) -> bool:
         s = self._state
         if s is None or s["body"].shape[0] != particles.n:
+            return False
+        if not np.array_equal(s["geometry"][[events.FALL_X, events.FALL_Y]], fall):
             return False
         if not np.array_equal(_piston_now(s["piston"], self._synced_at), piston):
             return False
@@ -424,7 +451,12 @@ class ExactCollisions:
         return bool(synced)
 
     def _rebuild(
-        self, particles: Particles, vessel: Vessel, now: float, piston: FloatArray
+        self,
+        particles: Particles,
+        vessel: Vessel,
+        now: float,
+        piston: FloatArray,
+        fall: FloatArray = _NO_FALL,
     ) -> dict[str, np.ndarray]:
         n = particles.n
         diameter = 2.0 * float(particles.radius.max(initial=0.0))
@@ -444,7 +476,7 @@ class ExactCollisions:
         half_width, half_height = (0.5 * float(side) for side in vessel.extent)
         s["geometry"] = np.array(
             [half_width, half_height, width / ncx, height / ncy, *(shared or (np.nan, np.nan)),
-             vessel.shape_code, vessel.rim, self.restitution, ELASTIC_BELOW, *window[0]]
+             vessel.shape_code, vessel.rim, self.restitution, ELASTIC_BELOW, *window[0], *fall]
         )  # fmt: skip
         s["grid"] = np.array([ncx, ncy, int(vessel.periodic)], dtype=np.int64)
         events.load(
@@ -468,12 +500,14 @@ class ExactCollisions:
         tally: Tally,
         acceleration: FloatArray | None = None,
         halt_after: float = math.inf,
+        fall: FloatArray | None = None,
     ) -> Contact | None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place, or halt before the first
         contact of forced particles after ``halt_after`` (s) and return it (`Drift.drift`)."""
-        _refuse_runaway(particles, vessel, dt)
-        if not self._is_current(particles, tally.piston):
-            self._state = self._rebuild(particles, vessel, now, tally.piston)
+        fall = _NO_FALL if fall is None else fall
+        _refuse_runaway(particles, vessel, dt, fall)
+        if not self._is_current(particles, tally.piston, fall):
+            self._state = self._rebuild(particles, vessel, now, tally.piston, fall)
             self.rebuilds += 1
         s = self._state
         assert s is not None
@@ -619,9 +653,9 @@ def _restored(saved: dict[str, np.ndarray]) -> dict[str, np.ndarray] | None:
 
 
 #: The layout of the engine's saved queues (2: walls after the cell crossings, any number of
-#: them; 3: the pairs' restitution in ``geometry``; 4: the cells' window there too); a queue saved
-#: with another is rebuilt, not read.
-_EVENT_CODES = 4
+#: them; 3: the pairs' restitution in ``geometry``; 4: the cells' window there too; 5: and the
+#: gravity the disks fall with); a queue saved with another is rebuilt, not read.
+_EVENT_CODES = 5
 
 
 #: The engine's arrays that are views of columns of ``event`` (`_engine_arrays`).

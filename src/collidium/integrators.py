@@ -14,7 +14,8 @@ kick-drift-kick and half after, a time-symmetric (Strang) splitting: a magnetic 
 velocities without changing speeds, and the energy drag or a thermostat gives the particles is
 kept in ``Tally.forces``.
 
-Without forces both are the same single drift: the exact engine is then untouched.
+Without forces both are the same single drift: the exact engine is then untouched. So is it
+under a uniform gravity alone, whose parabolas it flies exactly (`ForceField.fall`).
 """
 
 from __future__ import annotations
@@ -64,8 +65,9 @@ CONTACT_MARGIN = 1e-10
 class Integrator:
     """Advances the state over one reporting interval: the common part of the integrators.
 
-    Without forces every integrator is the same single drift (the exact engine's queue then
-    survives from step to step); with forces `step` hands over to `_with_forces`.
+    Without forces, or with only a uniform gravity that the drift carries, every integrator is
+    the same single drift (the exact engine's queue then survives from step to step); with
+    forces that kick `step` hands over to `_with_forces`.
 
     Parameters
     ----------
@@ -94,10 +96,10 @@ class Integrator:
         The acceleration of the current positions must be in the field's cache: `ForceField`
         evaluates it once before the first step, and the integrator keeps it current.
         """
-        if field.active:
+        if field.kicks:
             self._with_forces(particles, vessel, field, drift, now, dt, tally)
         else:
-            drift.drift(particles, vessel, now, dt, tally)
+            drift.drift(particles, vessel, now, dt, tally, fall=field.fall)
 
     def _with_forces(
         self,
@@ -147,7 +149,7 @@ class Leapfrog(Integrator):
         tally: Tally,
     ) -> None:
         _kick(particles, vessel, field, dt, tally)
-        drift.drift(particles, vessel, now, dt, tally, field.acceleration)
+        drift.drift(particles, vessel, now, dt, tally, field.acceleration, fall=field.fall)
         _closing_kick(particles, vessel, field, dt, tally)
 
 
@@ -276,21 +278,22 @@ class AdaptiveLeapfrog(Integrator):
         before = _Snapshot(particles, tally)
         h = end - t
         acceleration = field.acceleration
+        fall = field.fall
         halt_after = t + CONTACT_WINDOW * dt
         reached = end
         while True:
             _kick(particles, vessel, field, h, tally)
-            contact = drift.drift(particles, vessel, t, h, tally, acceleration, halt_after)
+            contact = drift.drift(particles, vessel, t, h, tally, acceleration, halt_after, fall)
             if contact is None:
                 break
             before.restore(particles, tally)
             # From the velocities before the velocity forces' half: they turn a velocity by
             # at most ``tolerance`` in it, within the margin the drift takes contacts in.
-            shortened = _shortened(particles, vessel, acceleration, contact, t, h, dt)
+            shortened = _shortened(particles, vessel, acceleration + fall, contact, t, h, dt)
             if shortened > CONTACT_WINDOW * dt:
                 h, reached = shortened, t + shortened
                 _kick(particles, vessel, field, h, tally)
-                drift.drift(particles, vessel, t, h, tally, acceleration)
+                drift.drift(particles, vessel, t, h, tally, acceleration, fall=fall)
                 break
             halt_after = contact.time
         _closing_kick(particles, vessel, field, h, tally)
@@ -340,7 +343,8 @@ def _shortened(
 ) -> float:
     """The substep (s) whose kick-drift-kick parabola ends just before ``contact``.
 
-    The drift after a kick ``a h / 2`` follows ``x + v h + a h^2 / 2`` at its end, so the contact
+    The drift after a kick ``a h / 2`` follows ``x + v h + a h^2 / 2`` at its end (``a`` with
+    the fall the drift carries), so the contact
     time is a root of ``|r + w h + b h^2 / 2| = sigma`` for a pair (relative position, velocity
     and acceleration) or the vessel's `Vessel.wall_gap` for a wall, found by Newton's method
     from the straight-path time the drift found. If that fails, the straight-path time is used.

@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike
 
 from collidium.collisions import COLLISION_MODES, CollisionMode, Tally, make_drift
 from collidium.errors import InputError, SimulationError
-from collidium.forces import Force, ForceField, force_from_dict
+from collidium.forces import Force, ForceField, PositionForce, force_from_dict
 from collidium.integrators import (
     DEFAULT_TOLERANCE,
     INTEGRATORS,
@@ -188,9 +188,9 @@ class Simulation:
         self.steps = 0
         self.observers: list[Observer] = []
         self._attached: list[Observer] = []  # observers already attached (by identity)
-        self._field = ForceField(tuple(forces), self.rng)
         self._restitution = float(restitution)
         self._drift = make_drift(collisions, self._restitution)
+        self._field = self._make_field(forces)
         self._integrator = make_integrator("adaptive", DEFAULT_TOLERANCE)
         self.tally = Tally.for_vessel(container)
 
@@ -260,6 +260,7 @@ class Simulation:
         if mode != self._collisions:
             self._collisions = mode
             self._drift = make_drift(mode, self._restitution)
+            self._field = self._make_field(self.forces)
 
     @property
     def restitution(self) -> float:
@@ -303,7 +304,12 @@ class Simulation:
     @forces.setter
     def forces(self, forces: Sequence[Force]) -> None:
         _check_forces(forces, self.container, self.particles)
-        self._field = ForceField(tuple(forces), self.rng)
+        self._field = self._make_field(forces)
+
+    def _make_field(self, forces: Sequence[Force]) -> ForceField:
+        """The forces as the integrators step with them, a uniform gravity carried by the drift
+        where it flies parabolas (`collidium.collisions.Drift.carries_fall`)."""
+        return ForceField(tuple(forces), self.rng, self._drift.carries_fall)
 
     def add_particles(self, new: Particles) -> None:
         """Put ``new`` particles into the vessel, after the others (a pump, a source).
@@ -369,7 +375,7 @@ class Simulation:
             if not any(observer is seen for seen in self._attached):
                 observer.attach(self)
                 self._attached.append(observer)
-        if self._field.active:
+        if self._field.kicks:
             self._field.evaluate(self.particles, self.container)
         if progress:
             from rich.console import Console
@@ -694,12 +700,21 @@ def _check_kinetic_energy(particles: Particles) -> None:
 
 
 def _check_forces(forces: Sequence[Force], container: Vessel, particles: Particles) -> None:
-    if forces and container.piston is not None:
-        raise InputError("forces", "a vessel with a piston holds a gas without forces")
+    if container.piston is not None and not all(_falls(force) for force in forces):
+        # The exact engine flies a uniform gravity; anything else would kick the gas while
+        # the piston moves on.
+        raise InputError(
+            "forces", "a vessel with a piston holds a gas without forces, or under gravity only"
+        )
     for k, force in enumerate(forces):
         if not isinstance(force, Force):
             raise InputError(f"forces.{k}", f"not a force: {type(force).__name__}")
         force.check(particles, container)
+
+
+def _falls(force: object) -> bool:
+    """Whether a force is a uniform gravity, the same acceleration for every particle."""
+    return isinstance(force, PositionForce) and force.fall is not None
 
 
 def _check_integrator(integrator: str, tolerance: float) -> None:

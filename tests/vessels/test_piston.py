@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from collidium.errors import InputError
-from collidium.forces import Coulomb
+from collidium.forces import Coulomb, Gravity
 from collidium.initial import random_positions
 from collidium.kernels import reference
 from collidium.simulation import Simulation, restore
@@ -91,6 +91,36 @@ def test_free_piston_conserves_the_energy_of_gas_piston_and_weight():
     state = sim.piston()
     assert state is not None
     assert state.work == pytest.approx(sim.energy().kinetic - kinetic, rel=1e-12, abs=1e-9)
+    assert sim.escaped() == 0
+
+
+def test_a_gas_under_gravity_below_a_free_piston_keeps_every_energy_to_round_off():
+    """Disks on parabolas meet a piston on its own parabola at roots of one quadratic: the
+    energy of gas (kinetic and potential), piston and weight holds to round-off, and the
+    piston's work is the gas's gain of energy."""
+    force, mass, g = 60.0, 8.0, 2.0
+    box = Box(20.0, 30.0, walls={"top": Piston(position=0.0, mass=mass, force=force)})
+    sim = Simulation(box, _gas(box, 200, 0.2, 5.0, seed=3), forces=[Gravity(g=(0.0, -g))],
+                     dt=0.5)  # fmt: skip
+
+    def gas() -> float:
+        return sim.energy().kinetic + sim.energy().potential
+
+    def total() -> float:
+        state = sim.piston()
+        assert state is not None
+        return gas() + 0.5 * mass * state.velocity**2 + force * state.position
+
+    start, gas_start = total(), gas()
+    sim.run(time=50.0)
+    assert sim.counters.wall_hits["top"] > 200
+    assert sim._drift.rebuilds == 1  # type: ignore[attr-defined]
+    # Round-off of the terms, not of their sum (the potential's zero is the box's centre).
+    state = sim.piston()
+    assert state is not None
+    scale = sim.energy().kinetic + abs(sim.energy().potential) + abs(force * state.position)
+    assert abs(total() - start) <= 1e-12 * scale
+    assert state.work == pytest.approx(gas() - gas_start, rel=1e-12, abs=1e-9)
     assert sim.escaped() == 0
 
 
@@ -196,15 +226,16 @@ def test_bad_pistons_are_refused_naming_the_field(make, field):
     assert caught.value.field == field
 
 
-def test_a_piston_needs_exact_collisions_no_forces_and_the_gas_behind_it():
+def test_a_piston_needs_exact_collisions_no_forces_but_gravity_and_the_gas_behind_it():
     box = Box(10.0, 10.0, walls={"top": Piston(position=0.0, mass=1.0)})
     below = Particles(np.array([[0.0, -2.0]]), np.zeros((1, 2)), radius=0.5)
     with pytest.raises(InputError, match="exact") as caught:
         Simulation(box, below, collisions="step")
     assert caught.value.field == "collisions"
     with pytest.raises(InputError) as caught:
-        Simulation(box, below, forces=[Coulomb(1.0)])
+        Simulation(box, below, forces=[Gravity(), Coulomb(1.0)])
     assert caught.value.field == "forces"
+    Simulation(box, below, forces=[Gravity()])  # the engine flies gravity's parabolas
     above = Particles(np.array([[0.0, 2.0]]), np.zeros((1, 2)), radius=0.5)
     with pytest.raises(InputError, match="outside") as caught:
         Simulation(box, above)

@@ -66,6 +66,13 @@ class PositionForce(Force, Protocol):
         by about ``sqrt(S) h^2`` (`collidium.integrators`); 0 for a uniform force, which leapfrog
         follows exactly. ``acceleration`` (N, 2) is the total of the last evaluation."""
 
+    @property
+    def fall(self) -> tuple[float, float] | None:
+        """The acceleration (x, y) in m/s^2 that the force gives every particle alike, whatever
+        its mass and charge (a uniform gravity), or None. A drift mode that `carries_fall`
+        (`collidium.collisions.Drift`) flies the particles on its parabolas instead of kicking
+        them."""
+
 
 @runtime_checkable
 class VelocityForce(Force, Protocol):
@@ -212,12 +219,27 @@ class ForceField:
         The forces acting; empty for free flight.
     rng : numpy.random.Generator, optional
         Where a thermostat draws its kicks (the simulation's generator, saved in checkpoints).
+    carry_fall : bool
+        Whether the drift flies the particles on the parabolas of the forces that give every
+        one the same acceleration (`PositionForce.fall`, a uniform gravity): those forces then
+        count in the energies but give no kicks (`fall`, `kicks`).
     """
 
-    def __init__(self, forces: tuple[Force, ...], rng: np.random.Generator | None = None) -> None:
+    def __init__(
+        self,
+        forces: tuple[Force, ...],
+        rng: np.random.Generator | None = None,
+        carry_fall: bool = False,
+    ) -> None:
         self.forces = tuple(forces)
         self._position = tuple(f for f in self.forces if isinstance(f, PositionForce))
         self._velocity = tuple(f for f in self.forces if isinstance(f, VelocityForce))
+        #: Per position force: whether the drift carries it (no kicks).
+        self._carried = tuple(carry_fall and f.fall is not None for f in self._position)
+        self._fall = np.zeros(2)
+        for force, carried in zip(self._position, self._carried, strict=True):
+            if carried:
+                self._fall += force.fall  # type: ignore[arg-type]
         self._rng = np.random.default_rng() if rng is None else rng
         self._work: list[dict[str, np.ndarray]] = [{} for _ in self._position]
         self._force = np.empty((0, 2))
@@ -238,9 +260,21 @@ class ForceField:
         """True when at least one force acts."""
         return bool(self.forces)
 
+    @property
+    def kicks(self) -> bool:
+        """True when a force acts that the drift does not carry: the integrator must then kick
+        or apply the velocity forces' flow."""
+        return bool(self._velocity) or not all(self._carried)
+
+    @property
+    def fall(self) -> FloatArray:
+        """The acceleration (2,) in m/s^2 that the drift carries (zero if it carries none)."""
+        return self._fall
+
     def evaluate(self, particles: Particles, vessel: Vessel) -> FloatArray:
-        """Total acceleration (N, 2) in m/s^2 of the position forces at the current positions;
-        also caches the potential and the virial."""
+        """Total acceleration (N, 2) in m/s^2 of the position forces at the current positions,
+        less the `fall` the drift carries; also caches the potential and the virial (of every
+        force)."""
         n = particles.n
         if self._force.shape[0] != n:
             self._force = np.empty((n, 2))
@@ -249,9 +283,10 @@ class ForceField:
             self._acceleration = np.empty((n, 2))
         self._acceleration[...] = 0.0
         potential = virial = 0.0
-        for force, work in zip(self._position, self._work, strict=True):
+        for force, work, carried in zip(self._position, self._work, self._carried, strict=True):
             force.compute(particles, vessel, self._force, self._energy, self._virial, work)
-            self._acceleration += self._force
+            if not carried:
+                self._acceleration += self._force
             potential += float(np.sum(self._energy))
             virial += float(np.sum(self._virial))
         with np.errstate(over="ignore"):  # an infinite acceleration is refused just below

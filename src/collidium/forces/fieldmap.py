@@ -42,6 +42,8 @@ class FieldMap:
     """
 
     name: ClassVar[str] = "field_map"
+    #: The field differs from place to place (`collidium.forces.base.PositionForce.fall`).
+    fall: ClassVar[None] = None
 
     potential: tuple[tuple[float, ...], ...]
     region: tuple[tuple[float, float], tuple[float, float]] | None = None

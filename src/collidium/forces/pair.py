@@ -127,6 +127,8 @@ class InverseDistanceForce:
 
     name: ClassVar[str]
     source: ClassVar[str]
+    #: Pair forces differ from particle to particle (`collidium.forces.base.PositionForce.fall`).
+    fall: ClassVar[None] = None
     softening: float
     method: SumMethod
     theta: float

@@ -58,6 +58,13 @@ class UniformForce:
         """0: leapfrog follows a uniform force exactly."""
         return 0.0
 
+    @property
+    def fall(self) -> tuple[float, float] | None:
+        """The field itself when it acts on the mass (the same acceleration for all), else None
+        (`collidium.forces.base.PositionForce.fall`)."""
+        vector: tuple[float, float] = getattr(self, self.vector)
+        return vector if self.source == "mass" else None
+
     def to_dict(self) -> dict[str, object]:
         """Parameters as in a scenario file."""
         return {"type": self.name, self.vector: list(getattr(self, self.vector))}

@@ -6,7 +6,12 @@ Design (Rapaport; Donev, Torquato & Stillinger; Bannerman's DynamO for the memor
 - Each particle keeps one next event: a pair contact, a wall contact or a crossing into the next
   cell of the grid. An 8-ary heap orders particles by that event time.
 - Positions are lazy: a particle's row holds where it was at its own time stamp; at time t it is
-  at ``x + v (t - stamp)``.
+  at ``x + v (t - stamp)``, or under a uniform gravity ``g`` that every disk shares on the
+  parabola ``x + v tau + g tau^2 / 2``, moving at ``v + g tau`` (``tau = t - stamp``). A pair's
+  relative motion is then still a straight line, so pair contacts keep their closed form; walls
+  and cell edges are met at roots of quadratics, a circle's rim and a segment's point at the
+  first crossing of a quartic (`collidium.kernels.parabolas`). The energy is kept to round-off
+  and the queue lives on from step to step, as without gravity.
 - A pair event records the partner's collision count when it was predicted; if the partner has
   collided since, the event is stale and the particle is simply re-predicted.
 - Cells are at least one largest diameter wide, so a particle's possible partners are in the
@@ -44,7 +49,7 @@ import math
 import numba
 import numpy as np
 
-from collidium.kernels import wall_responses
+from collidium.kernels import parabolas, wall_responses
 from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import energy_change, pair_response
 from collidium.kernels.vessels import BOX, contacts
@@ -61,10 +66,11 @@ SHARED_BODY_COLUMNS = 5  # 40 bytes: every disk has the radius and mass in ``geo
 #: (else NaN), the vessel's shape code (`collidium.kernels.vessels`) and, for a circle, its radius;
 #: then the pair collisions' restitution and the approach speed (m/s) below which they are
 #: elastic (`collidium.kernels.collision.pair_response`); then the lower-left corner of the
-#: cells' window (`collidium.kernels.cells.grid_window`: the box itself when periodic).
+#: cells' window (`collidium.kernels.cells.grid_window`: the box itself when periodic); then the
+#: uniform acceleration every disk falls with between events (m/s^2, `_at`).
 HALF_WIDTH, HALF_HEIGHT, CELL_WIDTH, CELL_HEIGHT, SHARED_RADIUS, SHARED_MASS, SHAPE, RIM = range(8)
-RESTITUTION, ELASTIC_BELOW, GRID_LEFT, GRID_BOTTOM = 8, 9, 10, 11
-GEOMETRY_SIZE = 12
+RESTITUTION, ELASTIC_BELOW, GRID_LEFT, GRID_BOTTOM, FALL_X, FALL_Y = range(8, 14)
+GEOMETRY_SIZE = 14
 
 #: Columns of the ``event`` rows (int32): the next event's code, the earliest pair contact found
 #: (its partner's slot, or -1; the event itself if it comes first) and that partner's collision
@@ -129,6 +135,19 @@ def _radius(k, body, geometry) -> float:
 def _mass(k, body, geometry) -> float:
     """Mass of slot k in kg: its row's, or the one all disks share."""
     return body[k, MASS] if body.shape[1] > MASS else geometry[SHARED_MASS]
+
+
+@_engine(inline="always")
+def _at(k, t, body, geometry):
+    """Slot k's position (m) and velocity (m/s) at time t (s): ``(x, y, vx, vy)``."""
+    lag = t - body[k, STAMP]
+    gx = geometry[FALL_X]
+    gy = geometry[FALL_Y]
+    vx = body[k, VX]
+    vy = body[k, VY]
+    x = body[k, X] + (vx + 0.5 * gx * lag) * lag
+    y = body[k, Y] + (vy + 0.5 * gy * lag) * lag
+    return x, y, vx + gx * lag, vy + gy * lag
 
 
 @_engine(inline="always")
@@ -283,39 +302,42 @@ def _heap_build(keys, items, where) -> None:
 
 @_engine(inline="always")
 def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid, segments, piston, now):
-    """Earliest wall contact or cell crossing of a disk at (x, y) in cell c at time ``now``
-    (s): ``(delay in s, code)``. Ties go to the first found: walls before cells, x before y.
-    With a piston (a non-empty ``piston``, `collidium.kernels.vessels.piston`) its wall of the
-    box moves."""
+    """Earliest wall contact or cell crossing of a disk at (x, y) moving at (vx, vy) in cell c at
+    time ``now`` (s), falling with the acceleration in ``geometry``: ``(delay in s, code)``. Ties
+    go to walls before cells, x before y, the lower edge before the upper. With a piston (a
+    non-empty ``piston``, `collidium.kernels.vessels.piston`) its wall of the box moves."""
     hw = geometry[HALF_WIDTH]
     hh = geometry[HALF_HEIGHT]
+    gx = geometry[FALL_X]
+    gy = geometry[FALL_Y]
     ncx = grid[0]
     periodic = grid[2] != 0
     best = math.inf
     code = NO_EVENT
-    if piston.shape[0] > 0:
-        best, contact = pistons.earliest(x, y, vx, vy, r, hw, hh, piston, now)
-        code = FIRST_WALL_CODE - contact
-    elif not periodic:
-        best, contact = contacts.earliest(x, y, vx, vy, r, geometry[SHAPE], hw, hh, geometry[RIM],
-                                          segments)  # fmt: skip
-        if contact >= 0:
-            code = FIRST_WALL_CODE - contact
     for d in range(2):  # cell crossings: -1 - (2 d + upper); none out of the edge cells
         v = vx if d == 0 else vy
+        g = gx if d == 0 else gy
         pos = x if d == 0 else y
-        low = geometry[GRID_LEFT + d]
-        size = geometry[CELL_WIDTH + d]
         at = c % ncx if d == 0 else c // ncx
-        cells = grid[d]
-        if v > 0.0 and (periodic or at < cells - 1):
-            delay = max((low + (at + 1) * size - pos) / v, 0.0)
-            if delay < best:
-                best, code = delay, -2 - 2 * d
-        elif v < 0.0 and (periodic or at > 0):
-            delay = max((low + at * size - pos) / v, 0.0)
+        size = geometry[CELL_WIDTH + d]
+        if periodic or at > 0:
+            delay = parabolas.first_contact(pos - (geometry[GRID_LEFT + d] + at * size), v, g)
             if delay < best:
                 best, code = delay, -1 - 2 * d
+        if periodic or at < grid[d] - 1:
+            upper = geometry[GRID_LEFT + d] + (at + 1) * size
+            delay = parabolas.first_contact(upper - pos, -v, -g)
+            if delay < best:
+                best, code = delay, -2 - 2 * d
+    if piston.shape[0] > 0:
+        wall, contact = pistons.earliest(x, y, vx, vy, r, hw, hh, piston, now, gx, gy)
+        if wall <= best:
+            best, code = wall, FIRST_WALL_CODE - contact
+    elif not periodic:
+        wall, contact = contacts.earliest(x, y, vx, vy, r, geometry[SHAPE], hw, hh, geometry[RIM],
+                                          segments, gx, gy, best)  # fmt: skip
+        if contact >= 0 and wall <= best:
+            best, code = wall, FIRST_WALL_CODE - contact
     return best, code
 
 
@@ -326,11 +348,10 @@ def _delay_to(j, now, x, y, vx, vy, r, sx, sy, body, geometry) -> float:
     rj = _radius(j, body, geometry)
     if rj <= 0.0:
         return math.inf
-    lag_j = now - body[j, STAMP]
-    vjx = body[j, VX]
-    vjy = body[j, VY]
-    dx = body[j, X] + vjx * lag_j + sx - x
-    dy = body[j, Y] + vjy * lag_j + sy - y
+    # Under a gravity both share, the relative motion is a straight line.
+    xj, yj, vjx, vjy = _at(j, now, body, geometry)
+    dx = xj + sx - x
+    dy = yj + sy - y
     sigma = r + rj
     slack = CONTACT_SLACK * sigma * (abs(vx) + abs(vy) + abs(vjx) + abs(vjy))
     return contact_delay(dx, dy, vjx - vx, vjy - vy, sigma, slack)
@@ -401,11 +422,7 @@ def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, 
     to the first found in a fixed order (walls, cells, then the partner with the lowest ident),
     so the outcome does not depend on the slot order.
     """
-    lag = now - body[k, STAMP]
-    vx = body[k, VX]
-    vy = body[k, VY]
-    x = body[k, X] + vx * lag
-    y = body[k, Y] + vy * lag
+    x, y, vx, vy = _at(k, now, body, geometry)
     r = _radius(k, body, geometry)
     when, code = _walls_and_cells(x, y, vx, vy, r, cell_of[k], geometry, grid, segments, piston,
                                   now)  # fmt: skip
@@ -716,7 +733,7 @@ def run_events(
             count[k] += 1
         elif code >= CELL_CODES[1]:
             crossed = -1 - code
-            _advance(k, t, body)
+            _advance(k, t, body, geometry)
             _cross_cell(k, crossed, body, ident, image, geometry, grid, cell_of, head, next_)
         t_k = predict(k, t, crossed, body, ident, geometry, grid, cell_of, head, next_, count,
                       event, segments, piston)  # fmt: skip
@@ -732,7 +749,7 @@ def _push_piston(k, t, body, ident, geometry, tally, impulse, heat, piston):
     """Slot k hits the piston at time t (s): snapped onto its face, both respond
     (`collidium.kernels.vessels.piston.hit`); the hit, the momentum and the work done on the gas
     are booked on the piston's wall."""
-    _advance(k, t, body)
+    _advance(k, t, body, geometry)
     x, y, _, _ = pistons.touch(piston, t, body[k, X], body[k, Y], _radius(k, body, geometry))
     body[k, X] = x
     body[k, Y] = y
@@ -761,10 +778,9 @@ def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count,
                                        next_, count, event, segments, piston)  # fmt: skip
             heap_update(k, t_k, keys, items, where)
             continue
-        lag = now - body[k, STAMP]
-        vx, vy = body[k, VX], body[k, VY]
-        when = now + pistons.delay(piston, now, body[k, X] + vx * lag, body[k, Y] + vy * lag, vx,
-                                   vy, _radius(k, body, geometry))  # fmt: skip
+        x, y, vx, vy = _at(k, now, body, geometry)
+        when = now + pistons.delay(piston, now, x, y, vx, vy, _radius(k, body, geometry),
+                                   geometry[FALL_X], geometry[FALL_Y])  # fmt: skip
         if when < keys[where[k]]:
             event[k, CODE] = code
             heap_update(k, when, keys, items, where)
@@ -803,10 +819,9 @@ def _halts(k, t, body, ident, count, event, acceleration, halt) -> bool:
 
 
 @_engine(inline="always")
-def _advance(k: int, t: float, body: np.ndarray) -> None:
-    lag = t - body[k, STAMP]
-    body[k, X] += body[k, VX] * lag
-    body[k, Y] += body[k, VY] * lag
+def _advance(k: int, t: float, body: np.ndarray, geometry: np.ndarray) -> None:
+    """Bring slot k's row to time t (s)."""
+    body[k, X], body[k, Y], body[k, VX], body[k, VY] = _at(k, t, body, geometry)
     body[k, STAMP] = t
 
 
@@ -814,8 +829,8 @@ def _advance(k: int, t: float, body: np.ndarray) -> None:
 def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration, midpoint, heat):
     """Collision of slots k and j at time t (s); an inelastic one books the kinetic energy it
     takes in ``heat[PAIR_COLLISIONS]`` (J, negative)."""
-    _advance(k, t, body)
-    _advance(j, t, body)
+    _advance(k, t, body, geometry)
+    _advance(j, t, body, geometry)
     # Contact normal x_k - x_j; in contact the pair is at most half a side apart, so the
     # minimum image is the one that touches.
     nx = body[k, X] - body[j, X]
@@ -844,7 +859,7 @@ def _bounce(k, contact, t, body, ident, geometry, tally, impulse, acceleration, 
     """Slot k meets the vessel at ``contact`` (`collidium.kernels.vessels.contacts`) at time t
     (s). The disk is first snapped onto the contact line, so that round-off never leaves it past
     the wall; then the wall responds (``walls``, the vessel's wall table)."""
-    _advance(k, t, body)
+    _advance(k, t, body, geometry)
     r = _radius(k, body, geometry)
     m = _mass(k, body, geometry)
     x, y, nx, ny, wall = contacts.touch(contact, body[k, X], body[k, Y], body[k, VX],
@@ -962,13 +977,11 @@ def synchronise(now, body, ident, geometry, grid, position, velocity) -> int:
     strays = 0
     for k in range(body.shape[0]):
         i = ident[k]
-        lag = now - body[k, STAMP]
-        x = body[k, X] + body[k, VX] * lag
-        y = body[k, Y] + body[k, VY] * lag
+        x, y, vx, vy = _at(k, now, body, geometry)
         position[i, 0] = x
         position[i, 1] = y
-        velocity[i, 0] = body[k, VX]
-        velocity[i, 1] = body[k, VY]
+        velocity[i, 0] = vx
+        velocity[i, 1] = vy
         strays += not (x0 <= x <= x1 and y0 <= y <= y1)
     return strays
 
@@ -979,12 +992,12 @@ def matches(now, body, ident, geometry, position, velocity, radius, mass) -> boo
     engine's radii and masses: nobody changed them since, and the queue is still valid."""
     for k in range(body.shape[0]):
         i = ident[k]
-        lag = now - body[k, STAMP]
+        x, y, vx, vy = _at(k, now, body, geometry)
         if (
-            position[i, 0] != body[k, X] + body[k, VX] * lag
-            or position[i, 1] != body[k, Y] + body[k, VY] * lag
-            or velocity[i, 0] != body[k, VX]
-            or velocity[i, 1] != body[k, VY]
+            position[i, 0] != x
+            or position[i, 1] != y
+            or velocity[i, 0] != vx
+            or velocity[i, 1] != vy
             or radius[i] != _radius(k, body, geometry)
             or mass[i] != _mass(k, body, geometry)
         ):

@@ -155,10 +155,13 @@ def event_drift(
     rim: float | None = None,
     table: FloatArray | None = None,
     box_walls: bool = True,
+    fall: FloatArray | None = None,
 ) -> tuple[int, int, float, FloatArray]:
     """Event-driven hard disks, all pairs (and, if periodic, all 9 images) checked at every event,
     in a box of half sides ``half`` or, with ``rim``, in a circle of that radius (m), and against
-    the segments of ``table`` (`segments`; without ``box_walls``, they are the only walls).
+    the segments of ``table`` (`segments`; without ``box_walls``, they are the only walls), all
+    falling with the acceleration ``fall`` (2,) m/s^2 (none by default): the pairs' relative
+    motion stays straight, the walls are met on parabolas.
 
     Positions and velocities (N, 2) are updated in place (periodic positions are left unwrapped).
     Returns (pair collisions, wall hits, collision virial ``sum r_ij . dp_i``, momentum received
@@ -168,6 +171,7 @@ def event_drift(
     pairs = walls = 0
     virial = 0.0
     table = np.empty((0, segments.SEGMENT_COLUMNS)) if table is None else table
+    g = np.zeros(2) if fall is None else np.asarray(fall, dtype=float)
     own = 1 if rim is not None else 4 if box_walls and not periodic else 0
     wall_impulse = np.zeros(own + len(table))
     while True:
@@ -175,17 +179,17 @@ def event_drift(
         if periodic:
             t_wall, k, d = math.inf, -1, -1
         elif rim is not None:
-            t_wall, k, d = _next_rim(position, velocity, radius, rim)
+            t_wall, k, d = _next_rim(position, velocity, radius, rim, g)
         elif box_walls:
-            t_wall, k, d = _next_wall(position, velocity, radius, half)
+            t_wall, k, d = _next_wall(position, velocity, radius, half, g)
         else:
             t_wall, k, d = math.inf, -1, -1
-        t_segment, s, e = _next_segment(position, velocity, radius, table)
+        t_segment, s, e = _next_segment(position, velocity, radius, table, g)
         best = min(t_pair, t_wall, t_segment)
         if now + best > duration:
-            position += velocity * (duration - now)
+            _fly(position, velocity, g, duration - now)
             return pairs, walls, virial, wall_impulse
-        position += velocity * best
+        _fly(position, velocity, g, best)
         now += best
         if t_segment < min(t_pair, t_wall):
             normal = _nearest_on_segment(position[s], table[e]) - position[s]
@@ -218,6 +222,12 @@ def event_drift(
             pairs += 1
 
 
+def _fly(position: FloatArray, velocity: FloatArray, fall: FloatArray, t: float) -> None:
+    """Every disk along its parabola for t seconds, in place."""
+    position += velocity * t + 0.5 * fall * t * t
+    velocity += fall * t
+
+
 def _nearest_on_segment(point: FloatArray, row: FloatArray) -> FloatArray:
     """The point of a segment (a row of a segment table) nearest to ``point``, m."""
     start = row[[segments.X0, segments.Y0]]
@@ -229,50 +239,63 @@ def _nearest_on_segment(point: FloatArray, row: FloatArray) -> FloatArray:
     return start + along * span
 
 
-def segment_delay(position: FloatArray, velocity: FloatArray, radius: float, row: FloatArray
-                  ) -> float:  # fmt: skip
+def segment_delay(position: FloatArray, velocity: FloatArray, radius: float, row: FloatArray,
+                  fall: FloatArray | None = None) -> float:  # fmt: skip
     """Twin of `segments.element_delay`: when a disk first comes ``radius`` from a segment while
-    approaching it, from the signed distance to its line (or NumPy's polynomial roots of the
-    squared distance to a point), inf if never."""
+    approaching it, from the signed distance to its line (or the squared distance to a point:
+    `distance_crossing`), inf if never. Under a ``fall`` (2,) m/s^2, the signed distance is a
+    quadratic whose roots at +-r come from `numpy.roots`."""
+    g = np.zeros(2) if fall is None else np.asarray(fall, dtype=float)
     start = row[[segments.X0, segments.Y0]]
     end = row[[segments.X1, segments.Y1]]
     span = end - start
     offset = position - start
-    if not span.any():  # a point: |offset + v t|^2 = r^2
-        if offset @ velocity >= 0:
-            return math.inf
-        roots = np.roots([velocity @ velocity, 2 * offset @ velocity, offset @ offset - radius**2])
-        real = roots[np.isreal(roots)].real
-        return max(float(real.min()), 0.0) if real.size else math.inf
+    if not span.any():
+        return distance_crossing(offset, velocity, g, radius, outward=False)
     normal = np.array([-span[1], span[0]]) / np.linalg.norm(span)
-    d0, w = float(offset @ normal), float(velocity @ normal)
-    if w == 0 or d0 * w >= 0:  # parallel, or moving away from the line
-        return math.inf
-    # The signed distance d0 + w t first reaches +-r on d0's side.
-    delay = max((math.copysign(radius, d0) - d0) / w, 0.0)
-    along = (offset + velocity * delay) @ span / (span @ span)
-    return delay if 0.0 <= along <= 1.0 else math.inf
+    d0, w, pull = float(offset @ normal), float(velocity @ normal), float(g @ normal)
+    side = math.copysign(1.0, d0)
+    times = []
+    if abs(d0) <= radius and side * w < 0:
+        times.append(0.0)  # within r of the line by round-off, and closing
+    # This side's face, met moving towards the line; the far one's, met coming back to it.
+    for level, toward in ((radius, -1.0), (-radius, 1.0)):
+        roots = np.roots([0.5 * pull, w, d0 - side * level]) if pull or w else np.array([])
+        for root in np.atleast_1d(roots):
+            t = float(root.real)
+            slope = w + pull * t
+            if abs(root.imag) <= 1e-12 * max(1.0, abs(t)) and t >= 0 and toward * side * slope > 0:
+                times.append(t)
+    for t in sorted(times):
+        along = (offset + velocity * t + 0.5 * g * t * t) @ span / (span @ span)
+        if 0.0 <= along <= 1.0:
+            return t
+    return math.inf
 
 
 def _next_segment(
-    position: FloatArray, velocity: FloatArray, radius: FloatArray, table: FloatArray
+    position: FloatArray,
+    velocity: FloatArray,
+    radius: FloatArray,
+    table: FloatArray,
+    fall: FloatArray,
 ) -> tuple[float, int, int]:
     """Earliest contact with a segment: (delay, particle, segment)."""
     best, particle, segment = math.inf, -1, -1
     for i in range(len(position)):
         for e in range(len(table)):
-            delay = segment_delay(position[i], velocity[i], radius[i], table[e])
+            delay = segment_delay(position[i], velocity[i], radius[i], table[e], fall)
             if delay < best:
                 best, particle, segment = delay, i, e
     return best, particle, segment
 
 
 def _next_rim(
-    position: FloatArray, velocity: FloatArray, radius: FloatArray, rim: float
+    position: FloatArray, velocity: FloatArray, radius: FloatArray, rim: float, fall: FloatArray
 ) -> tuple[float, int, int]:
     """Earliest contact with a circle's rim: (delay, particle, 0)."""
     delays = [
-        circle_wall_delay(x, v, r, rim)[0]
+        circle_wall_delay(x, v, r, rim, fall)[0]
         for x, v, r in zip(position, velocity, radius, strict=True)
     ]
     k = int(np.argmin(delays))
@@ -280,9 +303,22 @@ def _next_rim(
 
 
 def _next_wall(
-    position: FloatArray, velocity: FloatArray, radius: FloatArray, half: FloatArray
+    position: FloatArray,
+    velocity: FloatArray,
+    radius: FloatArray,
+    half: FloatArray,
+    fall: FloatArray | None = None,
 ) -> tuple[float, int, int]:
-    """Earliest wall contact: (delay, particle, axis)."""
+    """Earliest wall contact: (delay, particle, axis); under a ``fall``, from `first_contact`
+    for each wall."""
+    if fall is not None and fall.any():
+        delay = np.array([[min(first_contact(position[k, d] + half[d] - radius[k],
+                                             velocity[k, d], fall[d]),
+                               first_contact(half[d] - radius[k] - position[k, d],
+                                             -velocity[k, d], -fall[d]))
+                           for d in range(2)] for k in range(len(position))])  # fmt: skip
+        k, d = np.unravel_index(np.argmin(delay), delay.shape)
+        return float(delay[k, d]), int(k), int(d)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         target = np.where(velocity > 0, half - radius[:, None], radius[:, None] - half)
         delay = np.where(velocity != 0, (target - position) / velocity, np.inf)
@@ -292,21 +328,38 @@ def _next_wall(
 
 
 def box_wall_delay(
-    position: FloatArray, velocity: FloatArray, radius: float, half: FloatArray
+    position: FloatArray,
+    velocity: FloatArray,
+    radius: float,
+    half: FloatArray,
+    fall: FloatArray | None = None,
 ) -> tuple[float, int]:
     """Twin of `vessels.box.wall_delay` for one disk: ``(delay, wall)`` (walls 0 left, 1 right,
-    2 bottom, 3 top), ``(inf, -1)`` at rest; ties to the x walls."""
-    delay, _, axis = _next_wall(position[None, :], velocity[None, :], np.array([radius]), half)
-    if not math.isfinite(delay):
-        return math.inf, -1
-    return delay, 2 * axis + int(velocity[axis] > 0)
+    2 bottom, 3 top), ``(inf, -1)`` if none; ties to the x walls, then the lower wall. Under a
+    ``fall`` each wall's gap closes on a parabola (`first_contact`)."""
+    g = np.zeros(2) if fall is None else np.asarray(fall, dtype=float)
+    delays = [
+        first_contact((half[d] - radius) - sign * position[d], -sign * velocity[d], -sign * g[d])
+        for d in range(2)
+        for sign in (-1.0, 1.0)
+    ]  # fmt: skip
+    wall = int(np.argmin(delays))
+    return (delays[wall], wall) if math.isfinite(delays[wall]) else (math.inf, -1)
 
 
 def circle_wall_delay(
-    position: FloatArray, velocity: FloatArray, radius: float, rim: float
+    position: FloatArray,
+    velocity: FloatArray,
+    radius: float,
+    rim: float,
+    fall: FloatArray | None = None,
 ) -> tuple[float, int]:
     """Twin of `vessels.circle.wall_delay`: the largest root of ``|x + v t|^2 = (rim - r)^2``
-    from NumPy's polynomial roots, ``(delay, 0)``, or ``(inf, -1)`` at rest."""
+    from NumPy's polynomial roots, ``(delay, 0)``, or ``(inf, -1)`` at rest; under a ``fall``,
+    `distance_crossing`."""
+    if fall is not None and np.any(fall):
+        delay = distance_crossing(position, velocity, fall, rim - radius, outward=True)
+        return (delay, 0) if math.isfinite(delay) else (math.inf, -1)
     a = float(velocity @ velocity)
     if a == 0.0:
         return math.inf, -1
@@ -617,12 +670,14 @@ def _expansion(
     return field, phi, w
 
 
-def piston_contact(gap: float, rate: float, pull: float) -> float:
-    """Twin of `vessels.piston.first_contact`: the least root t >= 0 of
+def first_contact(gap: float, rate: float, pull: float) -> float:
+    """Twin of `parabolas.first_contact`: the least root t >= 0 of
     ``gap + rate t + pull t^2 / 2`` at which the gap is closing (a touch, later on, counts; at
     t = 0 a gap that only starts to open does not), by `numpy.roots`; inf if none."""
     gap = max(gap, 0.0)
-    roots = np.roots([0.5 * pull, rate, gap]) if pull or rate else np.array([])
+    if pull == 0.0:  # a straight path: one division (np.roots overflows for tiny rates)
+        return gap / -rate if rate < 0.0 else math.inf
+    roots = np.roots([0.5 * pull, rate, gap])
     closing = []
     for root in np.atleast_1d(roots):
         t = float(root.real)
@@ -632,6 +687,26 @@ def piston_contact(gap: float, rate: float, pull: float) -> float:
         if slope < 0.0 or (slope == 0.0 and (t > 0.0 or pull < 0.0)):
             closing.append(t)
     return min(closing, default=math.inf)
+
+
+def distance_crossing(
+    position: FloatArray, velocity: FloatArray, fall: FloatArray, reach: float, outward: bool
+) -> float:
+    """Twin of `parabolas.distance_crossing` (no horizon): the least root t >= 0 of the quartic
+    ``|p + v t + g t^2 / 2|^2 - reach^2`` at which the distance crosses ``reach`` outwards (or
+    inwards), by `numpy.roots`; 0 for a body already across and moving on across; inf if none."""
+    p, v, g = (np.asarray(a, dtype=float) for a in (position, velocity, fall))
+    sense = 1.0 if outward else -1.0
+    if sense * (np.linalg.norm(p) - reach) >= 0 and sense * (p @ v) > 0:
+        return 0.0
+    quartic = [g @ g / 4, v @ g, v @ v + p @ g, 2 * p @ v, p @ p - reach**2]
+    crossings = []
+    for root in np.roots(quartic):
+        t = float(root.real)
+        x, u = p + v * t + 0.5 * g * t * t, v + g * t
+        if abs(root.imag) <= 1e-9 * max(1.0, abs(t)) and t >= 0 and sense * (x @ u) > 0:
+            crossings.append(t)
+    return min(crossings, default=math.inf)
 
 
 def moving_wall(
@@ -684,14 +759,14 @@ def piston_drift(
         t_wall = float(delays[k, d])
         gaps = [p["height"] - sign * position[q, axis] - radius[q] for q in range(len(radius))]
         t_disks = [
-            piston_contact(g, p["speed"] - sign * velocity[q, axis], p["pull"])
+            first_contact(g, p["speed"] - sign * velocity[q, axis], p["pull"])
             for q, g in enumerate(gaps)
         ]
         q = int(np.argmin(t_disks)) if t_disks else -1
         t_piston = t_disks[q] if t_disks else math.inf
         t_end = min(
-            piston_contact(p["high"] - p["height"], -p["speed"], -p["pull"]),
-            piston_contact(p["height"] - p["low"], p["speed"], p["pull"]),
+            first_contact(p["high"] - p["height"], -p["speed"], -p["pull"]),
+            first_contact(p["height"] - p["low"], p["speed"], p["pull"]),
         )
         best = min(t_pair, t_wall, t_piston, t_end)
         if now + best > duration:

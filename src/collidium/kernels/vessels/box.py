@@ -14,33 +14,44 @@ import math
 import numba
 import numpy as np
 
+from collidium.kernels import parabolas
+
 
 @numba.njit(cache=True, inline="always")
 def wall_delay(
-    x: float, y: float, vx: float, vy: float, r: float, half_width: float, half_height: float
+    x: float,
+    y: float,
+    vx: float,
+    vy: float,
+    r: float,
+    half_width: float,
+    half_height: float,
+    gx: float = 0.0,
+    gy: float = 0.0,
 ) -> tuple[float, int]:
-    """Time until a disk of radius ``r`` at (x, y) moving at (vx, vy) touches a wall.
+    """Time until a disk of radius ``r`` at (x, y) moving at (vx, vy) under the acceleration
+    (gx, gy) (m/s^2) touches a wall.
 
     Returns
     -------
     tuple
-        ``(delay in s, wall)``; ``(inf, -1)`` at rest. A disk already at or past a wall it moves
-        towards gets 0. Ties go to the x walls.
+        ``(delay in s, wall)``; ``(inf, -1)`` if it never does. A disk already at or past a wall
+        it moves towards gets 0. Ties go to the x walls, then to the lower wall.
     """
     best = math.inf
     wall = -1
     for d in range(2):
         v = vx if d == 0 else vy
+        g = gx if d == 0 else gy
         position = x if d == 0 else y
         half = half_width if d == 0 else half_height
-        if v > 0.0:
-            delay = max((half - r - position) / v, 0.0)
-            if delay < best:
-                best, wall = delay, 2 * d + 1
-        elif v < 0.0:
-            delay = max((-half + r - position) / v, 0.0)
-            if delay < best:
-                best, wall = delay, 2 * d
+        # Gaps as (half - r) - position, exactly the straight path's arithmetic.
+        lower = parabolas.first_contact(position - (r - half), v, g)
+        upper = parabolas.first_contact((half - r) - position, -v, -g)
+        if lower < best:
+            best, wall = lower, 2 * d
+        if upper < best:
+            best, wall = upper, 2 * d + 1
     return best, wall
 
 

@@ -13,14 +13,33 @@ import math
 
 import numba
 
+from collidium.kernels import parabolas
+
 
 @numba.njit(cache=True, inline="always")
-def wall_delay(x: float, y: float, vx: float, vy: float, r: float, rim: float) -> tuple[float, int]:
-    """Time until a disk of radius ``r`` at (x, y) moving at (vx, vy) touches the rim.
+def wall_delay(
+    x: float,
+    y: float,
+    vx: float,
+    vy: float,
+    r: float,
+    rim: float,
+    gx: float = 0.0,
+    gy: float = 0.0,
+    horizon: float = math.inf,
+) -> tuple[float, int]:
+    """Time until a disk of radius ``r`` at (x, y) moving at (vx, vy) under the acceleration
+    (gx, gy) (m/s^2) touches the rim.
 
-    The later root of ``|x + v t| = rim - r`` (the disk is inside). Returns ``(delay in s, 0)``,
-    or ``(inf, -1)`` at rest; a disk at or past the rim moving outwards gets 0.
+    On a straight path, the later root of ``|x + v t| = rim - r`` (the disk is inside); on a
+    parabola, the first outward crossing (`collidium.kernels.parabolas.distance_crossing`),
+    looked for up to ``horizon`` (s; a contact after it may be reported as inf). Returns
+    ``(delay in s, 0)``, or ``(inf, -1)`` at rest; a disk at or past the rim moving outwards
+    gets 0.
     """
+    if gx != 0.0 or gy != 0.0:
+        delay = parabolas.distance_crossing(x, y, vx, vy, gx, gy, rim - r, True, horizon)
+        return (delay, 0) if delay < math.inf else (math.inf, -1)
     speed2 = vx * vx + vy * vy
     if speed2 == 0.0:
         return math.inf, -1

@@ -21,18 +21,21 @@ SEGMENTS_FROM = 4
 
 
 @numba.njit(cache=True, inline="always")
-def earliest(x, y, vx, vy, r, shape, half_width, half_height, rim, table) -> tuple[float, int]:
+def earliest(
+    x, y, vx, vy, r, shape, half_width, half_height, rim, table, gx=0.0, gy=0.0, horizon=math.inf
+) -> tuple[float, int]:
     """``(delay in s, contact)`` of the first wall a disk of radius ``r`` at (x, y) moving at
-    (vx, vy) touches; ``(inf, -1)`` if none. ``table`` is the vessel's segment table. Ties go
-    to the shape's walls."""
+    (vx, vy) under the acceleration (gx, gy) (m/s^2) touches; ``(inf, -1)`` if none. ``table``
+    is the vessel's segment table. Ties go to the shape's walls. On a parabola, curved contacts
+    (the rim, a segment's point) are looked for up to ``horizon`` (s) only."""
     if shape == CIRCLE:
-        best, contact = circle.wall_delay(x, y, vx, vy, r, rim)
+        best, contact = circle.wall_delay(x, y, vx, vy, r, rim, gx, gy, horizon)
     elif shape == BOX:
-        best, contact = box.wall_delay(x, y, vx, vy, r, half_width, half_height)
+        best, contact = box.wall_delay(x, y, vx, vy, r, half_width, half_height, gx, gy)
     else:
         best, contact = math.inf, -1
     if table.shape[0] > 0:
-        delay, e = segments.earliest(x, y, vx, vy, r, table)
+        delay, e = segments.earliest(x, y, vx, vy, r, table, gx, gy, min(best, horizon))
         if delay < best:
             best, contact = delay, SEGMENTS_FROM + e
     return best, contact

@@ -4,8 +4,9 @@ The piston is kept as one float64 array (`PISTON_SIZE` entries, `collidium.vesse
 piston_array`), in coordinates along the wall's outward normal: the face's height ``h`` (m, the
 box's centre at 0), its speed ``u`` (m/s, > 0 moving out of the box) and its constant
 acceleration ``a = -F / M`` (m/s^2) from the external force F pushing it in. Between hits it
-flies on the parabola ``h + u t + a t^2 / 2``, so its contacts with disks on straight paths are
-exact roots of quadratics (`first_contact`). Its travel is ``[LOW, HIGH]``, the ends of its
+flies on the parabola ``h + u t + a t^2 / 2``, so its contacts with disks on straight paths, or
+on parabolas of their own under a uniform gravity, are exact roots of quadratics
+(`collidium.kernels.parabolas.first_contact`). Its travel is ``[LOW, HIGH]``, the ends of its
 guides: a free piston bounces elastically at an end, a driven one stops there.
 
 Disk-piston hits are the response `collidium.kernels.wall_responses.moving_wall`. The box's other
@@ -20,6 +21,7 @@ import numba
 import numpy as np
 
 from collidium.kernels import wall_responses
+from collidium.kernels.parabolas import first_contact
 from collidium.kernels.vessels import box
 
 #: Entries of the piston array: the box wall it is (0 left, 1 right, 2 bottom, 3 top), its
@@ -28,36 +30,6 @@ from collidium.kernels.vessels import box
 #: next arrival at an end (s) and whether it is driven (1.0) or free (0.0).
 WALL, HEIGHT, SPEED, PULL, STAMP, MASS, RESTITUTION, LOW, HIGH, NEXT, DRIVEN = range(11)
 PISTON_SIZE = 11
-
-
-@numba.njit(cache=True, inline="always")
-def first_contact(gap: float, rate: float, pull: float) -> float:
-    """The first time t >= 0 at which ``gap + rate t + pull t^2 / 2`` reaches 0 from above, s.
-
-    Parameters
-    ----------
-    gap : float
-        The distance now, m (a negative value is round-off and counts as 0).
-    rate : float
-        Its rate of change now, m/s (< 0: closing).
-    pull : float
-        Its constant second derivative, m/s^2.
-
-    Returns
-    -------
-    float
-        The delay in s, inf if the gap never closes. Stable forms of the roots (no
-        cancellation for slow or grazing approaches).
-    """
-    gap = max(gap, 0.0)
-    if rate < 0.0:
-        disc = rate * rate - 2.0 * pull * gap
-        if disc < 0.0:
-            return math.inf  # turns back before touching (pull > 0)
-        return 2.0 * gap / (-rate + math.sqrt(disc))
-    if pull >= 0.0:
-        return math.inf
-    return (rate + math.sqrt(rate * rate - 2.0 * pull * gap)) / -pull
 
 
 @numba.njit(cache=True, inline="always")
@@ -84,21 +56,24 @@ def _axis_and_sign(piston: np.ndarray) -> tuple[int, float]:
 
 
 @numba.njit(cache=True, inline="always")
-def delay(piston, now, x, y, vx, vy, r) -> float:
-    """Time (s) from ``now`` until a disk of radius r at (x, y) moving at (vx, vy) touches the
-    piston; inf if never on their present paths."""
+def delay(piston, now, x, y, vx, vy, r, gx=0.0, gy=0.0) -> float:
+    """Time (s) from ``now`` until a disk of radius r at (x, y) moving at (vx, vy) under the
+    acceleration (gx, gy) (m/s^2) touches the piston; inf if never on their present paths."""
     axis, sign = _axis_and_sign(piston)
     s = sign * (x if axis == 0 else y)
     v = sign * (vx if axis == 0 else vy)
+    g = sign * (gx if axis == 0 else gy)
     height, speed = motion(piston, now)
-    return first_contact(height - s - r, speed - v, piston[PULL])
+    return first_contact(height - s - r, speed - v, piston[PULL] - g)
 
 
 @numba.njit(cache=True)
-def earliest(x, y, vx, vy, r, half_width, half_height, piston, now) -> tuple[float, int]:
+def earliest(x, y, vx, vy, r, half_width, half_height, piston, now, gx=0.0, gy=0.0
+             ) -> tuple[float, int]:  # fmt: skip
     """`collidium.kernels.vessels.box.wall_delay` for a box one of whose walls is the piston:
-    ``(delay in s, wall)`` of the first of the three fixed walls and the piston that the disk
-    touches. Ties go to the fixed walls, in their order."""
+    ``(delay in s, wall)`` of the first of the three fixed walls and the piston that the disk,
+    under the acceleration (gx, gy) (m/s^2), touches. Ties go to the fixed walls, in their
+    order."""
     moving = int(piston[WALL])
     best = math.inf
     wall = -1
@@ -106,14 +81,14 @@ def earliest(x, y, vx, vy, r, half_width, half_height, piston, now) -> tuple[flo
         if w == moving:
             continue
         d = w // 2
-        v = vx if d == 0 else vy
-        upper = w % 2 == 1
-        if (upper and v > 0.0) or (not upper and v < 0.0):
-            touching = box.contact_coordinate(w, r, half_width, half_height)
-            when = max((touching - (x if d == 0 else y)) / v, 0.0)
-            if when < best:
-                best, wall = when, w
-    when = delay(piston, now, x, y, vx, vy, r)
+        sign = 1.0 if w % 2 == 1 else -1.0
+        touching = box.contact_coordinate(w, r, half_width, half_height)
+        # The gap to the wall, closing at the disk's outward speed; as in box.wall_delay.
+        gap = sign * (touching - (x if d == 0 else y))
+        when = first_contact(gap, -sign * (vx if d == 0 else vy), -sign * (gx if d == 0 else gy))
+        if when < best:
+            best, wall = when, w
+    when = delay(piston, now, x, y, vx, vy, r, gx, gy)
     if when < best:
         best, wall = when, moving
     return best, wall

@@ -18,6 +18,8 @@ import math
 
 import numba
 
+from collidium.kernels import parabolas
+
 #: Columns of a segment table.
 X0, Y0, X1, Y1, TX, TY, LENGTH, WALL, BOUNDARY = range(9)
 SEGMENT_COLUMNS = 9
@@ -41,16 +43,34 @@ def point_delay(px: float, py: float, vx: float, vy: float, r: float) -> float:
 
 
 @numba.njit(cache=True, inline="always")
-def element_delay(x: float, y: float, vx: float, vy: float, r: float, segments, e: int) -> float:
-    """Time until a disk of radius ``r`` at (x, y) moving at (vx, vy) touches segment ``e``
-    (its flat part, from either side; a point if its length is 0); inf if it never does."""
+def element_delay(
+    x: float,
+    y: float,
+    vx: float,
+    vy: float,
+    r: float,
+    segments,
+    e: int,
+    gx: float = 0.0,
+    gy: float = 0.0,
+    horizon: float = math.inf,
+) -> float:
+    """Time until a disk of radius ``r`` at (x, y) moving at (vx, vy) under the acceleration
+    (gx, gy) (m/s^2) touches segment ``e`` (its flat part, from either side; a point if its
+    length is 0); inf if it never does. On a parabola a point is looked for up to ``horizon``
+    (s; a contact after it may be reported as inf)."""
     px = x - segments[e, X0]
     py = y - segments[e, Y0]
     length = segments[e, LENGTH]
+    falling = gx != 0.0 or gy != 0.0
     if length == 0.0:
+        if falling:
+            return parabolas.distance_crossing(px, py, vx, vy, gx, gy, r, False, horizon)
         return point_delay(px, py, vx, vy, r)
     tx = segments[e, TX]
     ty = segments[e, TY]
+    if falling:
+        return _flat_delay_on_parabola(px, py, vx, vy, gx, gy, r, tx, ty, length)
     distance = tx * py - ty * px  # along the normal (-ty, tx)
     approach = tx * vy - ty * vx
     if distance < 0.0:
@@ -65,13 +85,49 @@ def element_delay(x: float, y: float, vx: float, vy: float, r: float, segments, 
 
 
 @numba.njit(cache=True, inline="always")
-def earliest(x: float, y: float, vx: float, vy: float, r: float, segments) -> tuple[float, int]:
-    """``(delay in s, segment)`` of the first segment a disk touches; ``(inf, -1)`` if none.
-    Ties go to the first row."""
+def _flat_delay_on_parabola(px, py, vx, vy, gx, gy, r, tx, ty, length) -> float:
+    """`element_delay` of a flat part for a disk on a parabola, from (px, py) off the segment's
+    start: the first time its distance to the line, a quadratic in t, comes to r on the disk's
+    side while closing, or to r on the far side while coming back (a pull across the line may
+    carry a disk past an end and back under the segment), with the contact point within the
+    segment."""
+    distance = tx * py - ty * px  # along the normal (-ty, tx)
+    approach = tx * vy - ty * vx
+    pull = tx * gy - ty * gx
+    if distance < 0.0:
+        distance, approach, pull = -distance, -approach, -pull
+    near = parabolas.first_contact(distance - r, approach, pull)
+    far = parabolas.first_root(0.5 * pull, approach, distance + r, True)
+    best = math.inf
+    for delay in (near, far):
+        if not 0.0 <= delay < best:  # also NaN
+            continue
+        along = (px + (vx + 0.5 * gx * delay) * delay) * tx + (
+            py + (vy + 0.5 * gy * delay) * delay
+        ) * ty
+        if 0.0 <= along <= length:
+            best = delay
+    return best
+
+
+@numba.njit(cache=True, inline="always")
+def earliest(
+    x: float,
+    y: float,
+    vx: float,
+    vy: float,
+    r: float,
+    segments,
+    gx: float = 0.0,
+    gy: float = 0.0,
+    horizon: float = math.inf,
+) -> tuple[float, int]:
+    """``(delay in s, segment)`` of the first segment a disk touches (`element_delay`);
+    ``(inf, -1)`` if none. Ties go to the first row."""
     best = math.inf
     found = -1
     for e in range(segments.shape[0]):
-        delay = element_delay(x, y, vx, vy, r, segments, e)
+        delay = element_delay(x, y, vx, vy, r, segments, e, gx, gy, min(horizon, best))
         if delay < best:
             best, found = delay, e
     return best, found
