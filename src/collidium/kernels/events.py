@@ -304,31 +304,17 @@ def _heap_build(keys, items, where) -> None:
 def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid, segments, piston, now):
     """Earliest wall contact or cell crossing of a disk at (x, y) moving at (vx, vy) in cell c at
     time ``now`` (s), falling with the acceleration in ``geometry``: ``(delay in s, code)``. Ties
-    go to walls before cells, x before y, the lower edge before the upper. With a piston (a
-    non-empty ``piston``, `collidium.kernels.vessels.piston`) its wall of the box moves."""
+    go to walls before cells, x before y. With a piston (a non-empty ``piston``,
+    `collidium.kernels.vessels.piston`) its wall of the box moves."""
     hw = geometry[HALF_WIDTH]
     hh = geometry[HALF_HEIGHT]
     gx = geometry[FALL_X]
     gy = geometry[FALL_Y]
-    ncx = grid[0]
     periodic = grid[2] != 0
-    best = math.inf
-    code = NO_EVENT
-    for d in range(2):  # cell crossings: -1 - (2 d + upper); none out of the edge cells
-        v = vx if d == 0 else vy
-        g = gx if d == 0 else gy
-        pos = x if d == 0 else y
-        at = c % ncx if d == 0 else c // ncx
-        size = geometry[CELL_WIDTH + d]
-        if periodic or at > 0:
-            delay = parabolas.first_contact(pos - (geometry[GRID_LEFT + d] + at * size), v, g)
-            if delay < best:
-                best, code = delay, -1 - 2 * d
-        if periodic or at < grid[d] - 1:
-            upper = geometry[GRID_LEFT + d] + (at + 1) * size
-            delay = parabolas.first_contact(upper - pos, -v, -g)
-            if delay < best:
-                best, code = delay, -2 - 2 * d
+    if gx != 0.0 or gy != 0.0:
+        best, code = _falling_cell_crossing(x, y, vx, vy, gx, gy, c, geometry, grid)
+    else:
+        best, code = _cell_crossing(x, y, vx, vy, c, geometry, grid)
     if piston.shape[0] > 0:
         wall, contact = pistons.earliest(x, y, vx, vy, r, hw, hh, piston, now, gx, gy)
         if wall <= best:
@@ -338,6 +324,60 @@ def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid, segments, piston, now):
                                           segments, gx, gy, best)  # fmt: skip
         if contact >= 0 and wall <= best:
             best, code = wall, FIRST_WALL_CODE - contact
+    return best, code
+
+
+@_engine(inline="always")
+def _cell_crossing(x, y, vx, vy, c, geometry, grid):
+    """``(delay in s, code)`` of a straight path's crossing out of cell c (code ``-1 - (2 d +
+    upper)``; none out of the edge cells of a walled box). Ties go to x."""
+    ncx = grid[0]
+    periodic = grid[2] != 0
+    best = math.inf
+    code = NO_EVENT
+    for d in range(2):
+        v = vx if d == 0 else vy
+        pos = x if d == 0 else y
+        low = geometry[GRID_LEFT + d]
+        size = geometry[CELL_WIDTH + d]
+        at = c % ncx if d == 0 else c // ncx
+        cells = grid[d]
+        if v > 0.0 and (periodic or at < cells - 1):
+            delay = max((low + (at + 1) * size - pos) / v, 0.0)
+            if delay < best:
+                best, code = delay, -2 - 2 * d
+        elif v < 0.0 and (periodic or at > 0):
+            delay = max((low + at * size - pos) / v, 0.0)
+            if delay < best:
+                best, code = delay, -1 - 2 * d
+    return best, code
+
+
+@_engine()
+def _falling_cell_crossing(x, y, vx, vy, gx, gy, c, geometry, grid):
+    """`_cell_crossing` on a parabola: each edge's gap closes on a quadratic (a disk thrown up
+    may cross its cell's lower edge on the way down). Ties go to x, then to the lower edge. A
+    call, not inlined: only falling disks take it, and inlined it would add to the compile
+    time of every engine."""
+    ncx = grid[0]
+    periodic = grid[2] != 0
+    best = math.inf
+    code = NO_EVENT
+    for d in range(2):
+        v = vx if d == 0 else vy
+        g = gx if d == 0 else gy
+        pos = x if d == 0 else y
+        low = geometry[GRID_LEFT + d]
+        size = geometry[CELL_WIDTH + d]
+        at = c % ncx if d == 0 else c // ncx
+        if periodic or at > 0:
+            delay = parabolas.first_contact(pos - (low + at * size), v, g)
+            if delay < best:
+                best, code = delay, -1 - 2 * d
+        if periodic or at < grid[d] - 1:
+            delay = parabolas.first_contact((low + (at + 1) * size) - pos, -v, -g)
+            if delay < best:
+                best, code = delay, -2 - 2 * d
     return best, code
 
 

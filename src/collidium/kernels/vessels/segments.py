@@ -84,13 +84,14 @@ def element_delay(
     return delay
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _flat_delay_on_parabola(px, py, vx, vy, gx, gy, r, tx, ty, length) -> float:
     """`element_delay` of a flat part for a disk on a parabola, from (px, py) off the segment's
     start: the first time its distance to the line, a quadratic in t, comes to r on the disk's
     side while closing, or to r on the far side while coming back (a pull across the line may
     carry a disk past an end and back under the segment), with the contact point within the
-    segment."""
+    segment. A call, not inlined: the engine inlines `element_delay`, and this arithmetic would
+    only add to its compile time."""
     distance = tx * py - ty * px  # along the normal (-ty, tx)
     approach = tx * vy - ty * vx
     pull = tx * gy - ty * gx
