@@ -10,7 +10,8 @@ W1s ``step`` mode, same gas, dt = 0.01 s (all cores): particle-steps per second;
 W2  charged gas (all cores): microseconds per particle-step of the Coulomb sum, direct and tree,
     N = 200 .. 1e6, with the tree's RMS relative force error; direct pair interactions per second;
     REBOUND direct ("basic") and tree gravity at equal N.
-W3  the seed report's scenes (every preset): wall seconds per simulated second.
+W3  the seed report's scenes (every preset): wall seconds per simulated second, quiet and beside
+    one CPU-bound process per core (started and stopped here), and the ratio of the speeds.
 M   peak resident memory of an exact run at N = 1e6, and per particle.
 """
 
@@ -38,6 +39,7 @@ from collidium.presets import PRESETS, preset
 
 sys.path.insert(0, str(Path(__file__).parent))
 import peers
+from machine import busy_cores
 
 RESULTS = Path(__file__).parent / "results"
 PACKING = 0.3
@@ -160,25 +162,35 @@ def coulomb_costs(n: int, with_direct: bool, error_targets: int) -> dict[str, An
 
 
 def seed_scene_costs() -> list[dict[str, Any]]:
-    """W3: every preset, wall seconds per simulated second over its own duration (capped)."""
-    rows = []
+    """W3: every preset, wall seconds per simulated second over its own duration (capped), on a
+    quiet machine and beside one CPU-bound process per core (`machine.busy_cores`)."""
+    durations = {name: min(preset(name).run.time, 10.0) for name in PRESETS}
     for name in PRESETS:
-        duration = min(preset(name).run.time, 10.0)
         cd.load(name).run(steps=2)  # warm-up
-        sim = cd.load(name)
-        start = time.perf_counter()
-        sim.run(time=duration)
-        seconds = time.perf_counter() - start
-        rows.append(
-            {
-                "scene": name,
-                "n": sim.particles.n,
-                "simulated_seconds": duration,
-                "wall_seconds": seconds,
-                "wall_per_simulated": seconds / duration,
-            }
-        )
-    return rows
+    quiet = {name: _scene_seconds(name, duration) for name, duration in durations.items()}
+    with busy_cores() as cores:
+        busy = {name: _scene_seconds(name, duration) for name, duration in durations.items()}
+    return [
+        {
+            "scene": name,
+            "n": cd.load(name).particles.n,
+            "simulated_seconds": duration,
+            "wall_seconds": quiet[name],
+            "wall_per_simulated": quiet[name] / duration,
+            "busy_cores": cores,
+            "busy_wall_seconds": busy[name],
+            "busy_speed_ratio": quiet[name] / busy[name],
+        }
+        for name, duration in durations.items()
+    ]
+
+
+def _scene_seconds(name: str, duration: float) -> float:
+    """Wall seconds of a fresh preset run for ``duration`` simulated seconds."""
+    sim = cd.load(name)
+    start = time.perf_counter()
+    sim.run(time=duration)
+    return time.perf_counter() - start
 
 
 # VmHWM, not ru_maxrss: a child's ru_maxrss starts from its parent's at the fork. RssAnon and
@@ -340,8 +352,8 @@ def main() -> None:
             (
                 f"W3 {row['scene']} (N={row['n']})",
                 f"{row['wall_per_simulated']:.3g} wall s / sim s",
-                "",
-                "",
+                f"busy: {row['busy_wall_seconds'] / row['simulated_seconds']:.3g}",
+                f"busy/quiet speed {row['busy_speed_ratio']:.2f}",
             )
         )
 

@@ -299,9 +299,13 @@ class StepCollisions(_Stateless):
     def _sort(self, particles: Particles, vessel: Vessel, fresh: bool, uniform: bool) -> None:
         """Sort the particles into cells (from last step's order when there is one)."""
         if self._sorted:
-            self._sorted = stepper.update_cells(
+            stepper.gather_movers(
                 particles.position, particles.radius, fresh, uniform, self._window,
-                *self._shape, self._order, self._key, self._data_xy, self._data_r,
+                *self._shape, self._order, self._key, self._cell_r, self._data_xy, self._data_r,
+                self._new_key, self._movers, self._moved,
+            )  # fmt: skip
+            self._sorted = stepper.update_cells(
+                uniform, *self._shape, self._order, self._key, self._data_xy, self._data_r,
                 self._new_key, self._movers, self._grouped, self._moved, self._order_out,
                 self._key_out, self._start, self._cell_xy, self._cell_r,
             )  # fmt: skip

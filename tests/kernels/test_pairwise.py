@@ -6,8 +6,12 @@ import numba
 import numpy as np
 import pytest
 
-from collidium.kernels import reference
-from collidium.kernels.pairwise import inverse_distance_direct, inverse_distance_stiffness
+from collidium.kernels import pairwise, reference
+from collidium.kernels.pairwise import (
+    PARALLEL_DIRECT_FROM,
+    inverse_distance_direct,
+    inverse_distance_stiffness,
+)
 
 
 def _coulomb(position, charge, k=5.0, eps2=0.0, size=None):
@@ -62,9 +66,12 @@ def test_potential_of_two_charges_is_k_q1_q2_over_r():
     assert virial.sum() == pytest.approx(-5.0 / 4.0, rel=1e-15)
 
 
+# A quarter neutral: 2 * PARALLEL_DIRECT_FROM particles sum their rows in parallel.
+@pytest.mark.parametrize("n", [40, 2 * PARALLEL_DIRECT_FROM])
 @pytest.mark.parametrize("periodic", [False, True])
-def test_kernel_equals_numpy_twin(charges, periodic):
-    position, charge = charges
+def test_kernel_equals_numpy_twin(rng, n, periodic):
+    position = rng.uniform(-8, 8, (n, 2))
+    charge = rng.choice([-1.0, 1.0, 0.5, 0.0], n)
     size = np.array([16.0, 16.0]) if periodic else None
     got_force, got_energy, got_virial = _coulomb(position, charge, eps2=0.01, size=size)
     want = reference.inverse_distance_direct(position, charge, 5.0, 0.01, size)
@@ -92,6 +99,29 @@ def test_results_do_not_depend_on_the_number_of_threads(rng, periodic):
         numba.set_num_threads(before)
     for a, b in zip(single, double, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_rows_in_serial_and_in_parallel_are_bitwise_the_same(rng, periodic):
+    """Small scenes sum their rows on one thread (`PARALLEL_DIRECT_FROM`): that changes no bit."""
+    n = 300
+    position = rng.uniform(-50, 50, (n, 2))
+    velocity = rng.normal(0.0, 3.0, (n, 2))
+    charge = rng.choice([-1.0, 1.0, 2.0, 0.0], n)
+    mass = rng.uniform(0.1, 2.0, n)
+    outputs = []
+    for rows in (pairwise.direct_serial, pairwise.direct_parallel):
+        force, energy, virial = np.full((n, 2), np.nan), np.full(n, np.nan), np.full(n, np.nan)
+        rows(position, charge, 5.0, 0.01, 100.0, 100.0, periodic, force, energy, virial)
+        outputs.append((force, energy, virial))
+    for a, b in zip(*outputs, strict=True):
+        assert np.isfinite(a).all()
+        np.testing.assert_array_equal(a, b)
+    stiffness = [
+        rows(position, velocity, charge, mass, 5.0, 0.01, 100.0, 100.0, periodic)
+        for rows in (pairwise.stiffness_serial, pairwise.stiffness_parallel)
+    ]
+    assert stiffness[0] > 0.0 and stiffness[0] == stiffness[1]
 
 
 def test_neutral_particles_feel_and_exert_nothing(rng):

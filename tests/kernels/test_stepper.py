@@ -130,25 +130,29 @@ def test_cells_are_followed_from_step_to_step(rng):
             radius = radius * 1.1  # new radii are read
         out = {name: np.empty_like(array) for name, array in cells.items()}
         out["r"] = cells["r"]  # last step's radii, overwritten in place
-        done = stepper.update_cells(
-            position, radius, step == 2, False, _window(width, height), ncx, ncy, cells["order"],
-            cells["key"], np.empty((n, 2)), np.empty(n), np.empty(n, np.int32),
-            np.empty(n, np.int32), np.empty(n, np.int32),
-            np.empty(stepper.chunk_count(n), np.int64), out["order"],
-            out["key"], out["start"], out["xy"], out["r"],
-        )  # fmt: skip
+        done = _update(position, radius, step == 2, cells, out, width, height, ncx, ncy)
         assert done
         _check_sorted(out, position, radius, width, height, ncx, ncy)
         cells = out
     # Particles thrown anywhere: a full sort is the better way, and the update says so.
     scattered = rng.uniform(-0.5, 0.5, (n, 2)) * [width, height]
-    work = [np.empty(n, np.int32) for _ in range(5)]
-    assert not stepper.update_cells(
-        scattered, radius, False, False, _window(width, height), ncx, ncy, cells["order"],
-        cells["key"],
-        np.empty((n, 2)), np.empty(n), work[0], work[1], work[2],
-        np.empty(stepper.chunk_count(n), np.int64), work[3], work[4], np.empty_like(cells["start"]),
-        np.empty((n, 2)), np.empty(n),
+    out = {name: np.empty_like(array) for name, array in cells.items()}
+    assert not _update(scattered, radius, False, cells, out, width, height, ncx, ncy)
+
+
+def _update(position, radius, fresh, cells, out, width, height, ncx, ncy) -> bool:
+    """`gather_movers` then `update_cells` from ``cells`` into ``out``, as the step mode does."""
+    n = position.shape[0]
+    data_xy, data_r = np.empty((n, 2)), np.empty(n)
+    new_key, movers, grouped = (np.empty(n, np.int32) for _ in range(3))
+    moved = np.empty(stepper.chunk_count(n), np.int64)
+    stepper.gather_movers(
+        position, radius, fresh, False, _window(width, height), ncx, ncy, cells["order"],
+        cells["key"], cells["r"], data_xy, data_r, new_key, movers, moved,
+    )  # fmt: skip
+    return stepper.update_cells(
+        False, ncx, ncy, cells["order"], cells["key"], data_xy, data_r, new_key, movers, grouped,
+        moved, out["order"], out["key"], out["start"], out["xy"], out["r"],
     )  # fmt: skip
 
 

@@ -113,7 +113,6 @@ def _row_periodic(
     return fx, fy, u, w
 
 
-@numba.njit(cache=True, parallel=True)
 def inverse_distance_direct(
     position: np.ndarray,
     source: np.ndarray,
@@ -127,7 +126,8 @@ def inverse_distance_direct(
     virial: np.ndarray,
 ) -> None:
     """Inverse-distance forces and per-particle energies by direct summation, O(N^2), parallel
-    over rows: ``F_i = c s_i sum_j s_j r_ij / (r^2 + eps^2)^(3/2)``.
+    over rows from `PARALLEL_DIRECT_FROM` particles on, on the calling thread below:
+    ``F_i = c s_i sum_j s_j r_ij / (r^2 + eps^2)^(3/2)``.
 
     Only particles with a source enter the sums (a neutral one feels and exerts no Coulomb
     force), read from contiguous copies of their coordinates and sources. Each row is summed
@@ -154,8 +154,24 @@ def inverse_distance_direct(
     virial : ndarray, shape (N,)
         Output: half of ``sum_j r_ij . F_ij`` for each particle, J (sum = the pair virial).
     """
+    rows = direct_parallel if position.shape[0] >= PARALLEL_DIRECT_FROM else direct_serial
+    rows(position, source, coupling, softening2, width, height, periodic, force, energy, virial)
+
+
+#: Particles from which `inverse_distance_direct` and `inverse_distance_stiffness` run their rows
+#: in parallel: below, waking the second thread costs more than the rows bring, and far more when
+#: another program keeps it busy (`benchmarks/bench_threads.py`). A row is summed alike either
+#: way, so the results are bitwise the same. The choice is made here, in Python: a compiled
+#: kernel calling a parallel one breaks numba's cache (the caller, once cached against a callee
+#: itself loaded from the cache, crashes the next process that loads it).
+PARALLEL_DIRECT_FROM = 256
+
+
+@numba.njit(cache=True, inline="always")
+def _sources(position, source, force, energy, virial):
+    """Zero the outputs; the particles with a source as contiguous ``x, y, q`` and their
+    ``index`` (work arrays of O(N) for O(N^2) work)."""
     n = position.shape[0]
-    # Particles with a source only, as contiguous x, y, q (work arrays of O(N) for O(N^2) work).
     x = np.empty(n)
     y = np.empty(n)
     q = np.empty(n)
@@ -172,19 +188,47 @@ def inverse_distance_direct(
             q[m] = source[i]
             index[m] = i
             m += 1
-    for c in numba.prange(m):
-        xi, yi, kqi = x[c], y[c], coupling * q[c]
-        if periodic:
-            below = _row_periodic(0, c, xi, yi, kqi, x, y, q, softening2, width, height)
-            above = _row_periodic(c + 1, m, xi, yi, kqi, x, y, q, softening2, width, height)
-        else:
-            below = _row(0, c, xi, yi, kqi, x, y, q, softening2)
-            above = _row(c + 1, m, xi, yi, kqi, x, y, q, softening2)
-        i = index[c]
-        force[i, 0] = below[0] + above[0]
-        force[i, 1] = below[1] + above[1]
-        energy[i] = 0.5 * (below[2] + above[2])
-        virial[i] = 0.5 * (below[3] + above[3])
+    return x[:m], y[:m], q[:m], index[:m]
+
+
+@numba.njit(cache=True, inline="always")
+def _direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force, energy,
+                virial) -> None:  # fmt: skip
+    """Row c of `inverse_distance_direct`: the sums over ``j < c`` then ``j > c``, written to
+    the particle ``index[c]``."""
+    m = x.shape[0]
+    xi, yi, kqi = x[c], y[c], coupling * q[c]
+    if periodic:
+        below = _row_periodic(0, c, xi, yi, kqi, x, y, q, softening2, width, height)
+        above = _row_periodic(c + 1, m, xi, yi, kqi, x, y, q, softening2, width, height)
+    else:
+        below = _row(0, c, xi, yi, kqi, x, y, q, softening2)
+        above = _row(c + 1, m, xi, yi, kqi, x, y, q, softening2)
+    i = index[c]
+    force[i, 0] = below[0] + above[0]
+    force[i, 1] = below[1] + above[1]
+    energy[i] = 0.5 * (below[2] + above[2])
+    virial[i] = 0.5 * (below[3] + above[3])
+
+
+@numba.njit(cache=True, parallel=True)
+def direct_parallel(position, source, coupling, softening2, width, height, periodic, force,
+                    energy, virial) -> None:  # fmt: skip
+    """`inverse_distance_direct`'s rows in parallel."""
+    x, y, q, index = _sources(position, source, force, energy, virial)
+    for c in numba.prange(x.shape[0]):
+        _direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force,
+                    energy, virial)  # fmt: skip
+
+
+@numba.njit(cache=True)
+def direct_serial(position, source, coupling, softening2, width, height, periodic, force,
+                  energy, virial) -> None:  # fmt: skip
+    """`inverse_distance_direct`'s rows on the calling thread."""
+    x, y, q, index = _sources(position, source, force, energy, virial)
+    for c in range(x.shape[0]):
+        _direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force,
+                    energy, virial)  # fmt: skip
 
 
 @numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
@@ -221,14 +265,32 @@ def _stiffness_row(
     return stiffness
 
 
-#: Particles with a source from which `inverse_distance_stiffness` runs its rows in parallel
-#: (below, starting the threads costs more than the rows).
-PARALLEL_STIFFNESS_FROM = 256
+@numba.njit(cache=True, inline="always")
+def _moving_sources(position, velocity, source, mass):
+    """The particles with a source as contiguous ``x, y, vx, vy, q`` and inverse masses."""
+    n = position.shape[0]
+    m = 0
+    for i in range(n):
+        if source[i] != 0.0:
+            m += 1
+    x, y = np.empty(m), np.empty(m)
+    vx, vy = np.empty(m), np.empty(m)
+    q, inverse_mass = np.empty(m), np.empty(m)
+    c = 0
+    for i in range(n):
+        if source[i] != 0.0:
+            x[c], y[c] = position[i, 0], position[i, 1]
+            vx[c], vy[c] = velocity[i, 0], velocity[i, 1]
+            q[c], inverse_mass[c] = source[i], 1.0 / mass[i]
+            c += 1
+    return x, y, vx, vy, q, inverse_mass
 
 
 @numba.njit(cache=True, parallel=True)
-def _stiffness_parallel(x, y, vx, vy, q, inverse_mass, coupling, softening2, width, height,
-                        periodic):  # fmt: skip
+def stiffness_parallel(position, velocity, source, mass, coupling, softening2, width, height,
+                       periodic) -> float:  # fmt: skip
+    """`inverse_distance_stiffness`'s rows in parallel."""
+    x, y, vx, vy, q, inverse_mass = _moving_sources(position, velocity, source, mass)
     m = x.shape[0]
     rows = np.zeros(m)
     for c in numba.prange(m):
@@ -239,6 +301,18 @@ def _stiffness_parallel(x, y, vx, vy, q, inverse_mass, coupling, softening2, wid
 
 
 @numba.njit(cache=True)
+def stiffness_serial(position, velocity, source, mass, coupling, softening2, width, height,
+                     periodic) -> float:  # fmt: skip
+    """`inverse_distance_stiffness`'s rows on the calling thread."""
+    x, y, vx, vy, q, inverse_mass = _moving_sources(position, velocity, source, mass)
+    stiffness = 0.0
+    for c in range(x.shape[0]):
+        row = _stiffness_row(c, x, y, vx, vy, q, inverse_mass, coupling, softening2, width, height,
+                             periodic)  # fmt: skip
+        stiffness = max(stiffness, row)
+    return stiffness
+
+
 def inverse_distance_stiffness(
     position: np.ndarray,
     velocity: np.ndarray,
@@ -250,7 +324,8 @@ def inverse_distance_stiffness(
     height: float,
     periodic: bool,
 ) -> float:
-    """How fast the inverse-distance pair energies change, for the adaptive integrator's substeps.
+    """How fast the inverse-distance pair energies change, for the adaptive integrator's substeps
+    (rows in parallel from `PARALLEL_DIRECT_FROM` particles on).
 
     For each pair of particles with sources, with ``s^2 = r^2 + eps^2`` (minimum image when
     ``periodic``), ``|U_ij| = |c q_i q_j| / s`` and the squared rate
@@ -281,27 +356,6 @@ def inverse_distance_stiffness(
         The largest ``(|U_ij| rate_ij^2)^2`` over pairs, in J^2/s^4 (0 with fewer than two
         sources).
     """
-    n = position.shape[0]
-    m = 0
-    for i in range(n):
-        if source[i] != 0.0:
-            m += 1
-    x, y = np.empty(m), np.empty(m)
-    vx, vy = np.empty(m), np.empty(m)
-    q, inverse_mass = np.empty(m), np.empty(m)
-    c = 0
-    for i in range(n):
-        if source[i] != 0.0:
-            x[c], y[c] = position[i, 0], position[i, 1]
-            vx[c], vy[c] = velocity[i, 0], velocity[i, 1]
-            q[c], inverse_mass[c] = source[i], 1.0 / mass[i]
-            c += 1
-    if m >= PARALLEL_STIFFNESS_FROM:
-        return _stiffness_parallel(x, y, vx, vy, q, inverse_mass, coupling, softening2, width,
-                                   height, periodic)  # fmt: skip
-    stiffness = 0.0
-    for c in range(m):
-        row = _stiffness_row(c, x, y, vx, vy, q, inverse_mass, coupling, softening2, width, height,
-                             periodic)  # fmt: skip
-        stiffness = max(stiffness, row)
-    return stiffness
+    rows = stiffness_parallel if position.shape[0] >= PARALLEL_DIRECT_FROM else stiffness_serial
+    return float(rows(position, velocity, source, mass, coupling, softening2, width, height,
+                      periodic))  # fmt: skip

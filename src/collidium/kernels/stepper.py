@@ -280,7 +280,8 @@ def _gather_chunk(
     lo: int,
     hi: int,
 ) -> int:
-    """`_gather` for slots ``lo:hi``: returns the number of movers listed from ``movers[lo]``."""
+    """`gather_movers` for slots ``lo:hi``: returns the number of movers listed from
+    ``movers[lo]``."""
     # The random reads alone first, so that many are in flight at once.
     for s in range(_u(lo), _u(hi)):
         i = _u(order[s])
@@ -306,7 +307,7 @@ def _gather_chunk(
 
 
 @numba.njit(cache=True, parallel=True)
-def _gather(
+def gather_movers(
     position: np.ndarray,
     radius: np.ndarray,
     fresh_radius: bool,
@@ -327,7 +328,26 @@ def _gather(
 
     Chunk ``p`` of the slots lists the slots whose particle changed cell from ``movers[lo_p]``
     on, and their number in ``moved[p]``. Radii are taken from last step's ``cell_r`` unless
-    ``fresh_radius``, and not at all if ``uniform``.
+    ``fresh_radius``, and not at all if ``uniform``. `update_cells` goes on from here.
+
+    Parameters
+    ----------
+    position, radius, window, ncx, ncy
+        As `sort_into_cells`.
+    fresh_radius : bool
+        The radii changed since the step before: read them from ``radius``, not ``cell_r``.
+    uniform : bool
+        All radii are equal: no radius is gathered.
+    order, key : ndarray of int, shape (N,)
+        Last step's `order_out` and `key_out` (or the output of `sort_into_cells`).
+    cell_r : ndarray of float64, shape (N,)
+        Last step's radii by slot.
+    data_xy, data_r : ndarray of float64, shapes (N, 2) and (N,)
+        Output: centre and radius of ``order[s]`` in entry ``s``.
+    new_key, movers : ndarray of int, shape (N,)
+        Output: each slot's new cell; the slots that changed cell, by chunk.
+    moved : ndarray of int64, shape (P,)
+        Output: the movers of each chunk, ``P = chunk_count(N)``.
     """
     n = order.shape[0]
     chunks = moved.shape[0]
@@ -444,11 +464,7 @@ def _fill_start(
 
 @numba.njit(cache=True, parallel=True)
 def update_cells(
-    position: np.ndarray,
-    radius: np.ndarray,
-    fresh_radius: bool,
     uniform: bool,
-    window: np.ndarray,
     ncx: int,
     ncy: int,
     order: np.ndarray,
@@ -473,30 +489,23 @@ def update_cells(
     the order then depends on the history, which the pair search does not see (it sorts the
     pairs it finds); the result does not depend on the number of threads.
 
+    The centres, radii and new cells come from `gather_movers`, called just before (from
+    Python: a compiled kernel calling a parallel one breaks numba's cache,
+    `pairwise.PARALLEL_DIRECT_FROM`).
+
     Parameters
     ----------
-    position : ndarray, shape (N, 2)
-        Centres in m, inside the box.
-    radius : ndarray, shape (N,)
-        Radii in m.
-    fresh_radius : bool
-        The radii changed since the step before: read them from ``radius``, not ``cell_r``.
     uniform : bool
         All radii are equal: ``cell_r`` is left alone (it holds that radius in every entry, in
         any order).
-    window : ndarray, shape (2, 2)
-        Lower-left and upper-right corners (m) of the rectangle the cells cover
-        (`cells.grid_window`); particles outside it are in its edge cells.
     ncx, ncy : int
         Grid shape.
     order, key : ndarray of int, shape (N,)
         Last step's `order_out` and `key_out` (or the output of `sort_into_cells`).
-    data_xy, data_r : ndarray of float64, shapes (N, 2) and (N,)
-        Work arrays.
-    new_key, movers, grouped : ndarray of int, shape (N,)
-        Work arrays.
-    moved : ndarray of int64, shape (P,)
-        Work array, ``P = chunk_count(N)``.
+    data_xy, data_r, new_key, movers, moved : ndarray
+        What `gather_movers` wrote.
+    grouped : ndarray of int, shape (N,)
+        Work array.
     order_out, key_out : ndarray of int, shape (N,)
         Output: particle index and cell in each slot, by cell.
     start : ndarray of int, shape (ncx * ncy + 1,)
@@ -513,10 +522,6 @@ def update_cells(
     """
     n = order.shape[0]
     ncells = ncx * ncy
-    _gather(
-        position, radius, fresh_radius, uniform, window, ncx, ncy, order, key, cell_r,
-        data_xy, data_r, new_key, movers, moved,
-    )  # fmt: skip
     chunks = moved.shape[0]
     if moved.sum() > n // 8:
         return False

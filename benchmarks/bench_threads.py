@@ -1,0 +1,101 @@
+"""Serial or parallel: where a kernel's rows are worth the second thread, quiet and on a busy
+machine.
+
+Run: ``python benchmarks/bench_threads.py [--sizes 2 8 32 64 128 256 1024] [--repeats 5]``.
+Prints a table and writes ``benchmarks/results/threads.json``.
+
+T1  the direct inverse-distance sum (`collidium.kernels.pairwise`): microseconds per call (the
+    median of the repeats) on the calling thread (`direct_serial`) and on all threads
+    (`direct_parallel`), for N charges, first on a quiet machine, then beside one CPU-bound
+    process per core, which this script starts and stops. Both give the same bits;
+    `inverse_distance_direct` switches at ``PARALLEL_DIRECT_FROM``.
+T2  the same for the adaptive substeps' stiffness (`stiffness_serial`, `stiffness_parallel`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numba
+import numpy as np
+
+from collidium.kernels import pairwise
+
+sys.path.insert(0, str(Path(__file__).parent))
+from machine import busy_cores
+
+RESULTS = Path(__file__).parent / "results"
+
+
+def median_microseconds(call: Callable[[], None], repeats: int, budget: float = 0.2) -> float:
+    """The median of ``repeats`` averages over as many calls as fit about ``budget`` seconds (a
+    median, not the best: on a busy machine the stalls are what is measured)."""
+    call()
+    start = time.perf_counter()
+    call()
+    calls = max(1, int(budget / max(time.perf_counter() - start, 1e-7)))
+    averages = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for _ in range(calls):
+            call()
+        averages.append((time.perf_counter() - start) / calls)
+    return float(np.median(averages)) * 1e6
+
+
+def kernel_rows(n: int, repeats: int) -> list[dict[str, Any]]:
+    """T1 and T2 at one size: each kernel's serial and parallel rows on the same charges."""
+    rng = np.random.default_rng(1)
+    position = rng.uniform(-10.0, 10.0, (n, 2))
+    velocity = rng.normal(0.0, 1.0, (n, 2))
+    charge = rng.choice([-1.0, 1.0], n)
+    mass = np.ones(n)
+    force, energy, virial = np.empty((n, 2)), np.empty(n), np.empty(n)
+    direct = (position, charge, 1.0, 0.01, 20.0, 20.0, False, force, energy, virial)
+    stiffness = (position, velocity, charge, mass, 1.0, 0.01, 20.0, 20.0, False)
+    rows = []
+    for name, serial, parallel, args in (
+        ("T1 direct sum", pairwise.direct_serial, pairwise.direct_parallel, direct),
+        ("T2 stiffness", pairwise.stiffness_serial, pairwise.stiffness_parallel, stiffness),
+    ):
+        rows.append(
+            {
+                "kernel": name,
+                "n": n,
+                "serial_us": median_microseconds(lambda s=serial, a=args: s(*a), repeats),
+                "parallel_us": median_microseconds(lambda p=parallel, a=args: p(*a), repeats),
+            }
+        )
+    return rows
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[2, 32, 128, 256, 512, 1024])
+    parser.add_argument("--repeats", type=int, default=5)
+    args = parser.parse_args()
+    rows: list[dict[str, Any]] = []
+    rows += [row | {"load": "quiet"} for n in args.sizes for row in kernel_rows(n, args.repeats)]
+    with busy_cores() as cores:
+        rows += [row | {"load": "busy"} for n in args.sizes for row in kernel_rows(n, args.repeats)]
+    print(
+        f"{numba.get_num_threads()} threads; busy: beside {cores} CPU-bound processes; the "
+        f"kernels go parallel from N = {pairwise.PARALLEL_DIRECT_FROM}"
+    )
+    print(f"{'':<16}{'load':>6}{'N':>7}{'serial us':>12}{'parallel us':>13}{'par/ser':>9}")
+    for row in sorted(rows, key=lambda r: (r["kernel"], r["load"] == "busy", r["n"])):
+        ratio = row["parallel_us"] / row["serial_us"]
+        print(f"{row['kernel']:<16}{row['load']:>6}{row['n']:>7}{row['serial_us']:>12.1f}"
+              f"{row['parallel_us']:>13.1f}{ratio:>9.2f}")  # fmt: skip
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "threads.json").write_text(json.dumps(rows, indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    main()
