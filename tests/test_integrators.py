@@ -12,7 +12,13 @@ import pytest
 import collidium as cd
 from collidium.collisions import Contact
 from collidium.errors import InputError, SimulationError
-from collidium.integrators import CONTACT_MARGIN, DEFAULT_TOLERANCE, AdaptiveLeapfrog, _shortened
+from collidium.integrators import (
+    CONTACT_MARGIN,
+    DEFAULT_TOLERANCE,
+    MAX_CONTACTS,
+    AdaptiveLeapfrog,
+    _shortened,
+)
 from collidium.observers import EnergyDrift
 
 
@@ -104,6 +110,20 @@ def test_forces_too_strong_for_dt_stop_the_run_at_once():
     with pytest.raises(SimulationError, match="too strong for this dt"):
         sim.run(steps=1)
     assert sim.steps == 0
+
+
+def test_endless_contacts_under_forces_stop_the_run_where_the_step_began():
+    """A charged disk at 2^31 m/s in a 20 m box would hit its walls a million times in one dt,
+    each contact a force evaluation (the fuzz test found it taking minutes): the run stops in one
+    line after `MAX_CONTACTS` of them, with the particles as they were before the step."""
+    sim = cd.load("charged-gas", n=20)
+    sim.particles.velocity[0] = [2.0**31, 0.0]
+    before = sim.particles.copy()
+    with pytest.raises(SimulationError, match=f"more than {MAX_CONTACTS} contacts"):
+        sim.run(steps=1)
+    assert sim.steps == 0 and sim.time == 0.0
+    np.testing.assert_array_equal(sim.particles.position, before.position)
+    np.testing.assert_array_equal(sim.particles.velocity, before.velocity)
 
 
 def test_halving_the_tolerance_quarters_the_error():

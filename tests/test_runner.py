@@ -13,7 +13,7 @@ import collidium as cd
 from collidium.errors import InputError
 from collidium.io.trajectory import GSDWriter, read_trajectory
 from collidium.loading import load_scenario
-from collidium.runner import Job, execute, record, resume
+from collidium.runner import Job, execute, prepare, record, resume
 from test_cli import collidium
 
 TRAJECTORY = '\n[[observers]]\nkind = "trajectory"\npath = "mine.gsd"\nevery = 10\n'
@@ -200,3 +200,12 @@ def test_record_returns_the_runs_trajectory_with_some_200_frames():
     sim = cd.load("gas", n=30).run(time=4.0)
     np.testing.assert_allclose(trajectory.position[-1], sim.particles.position, atol=1e-5)
     assert record(load_scenario("gas", n=30), time=1.0, every=25).frames == 5
+
+
+@pytest.mark.parametrize(("dt", "every"), [(0.01, 10), (0.3, 1), (5e-324, 10**12)])
+def test_frames_come_every_tenth_of_a_second_by_default(dt, every):
+    """Ten frames a simulated second, at least one step apart; a subnormal dt (the fuzz test's)
+    asks for more steps than a run may have, not an overflow."""
+    spec = load_scenario("gas", n=10, dt=dt)
+    _, job = prepare(spec, steps=1)
+    assert job.every == every

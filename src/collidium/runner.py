@@ -40,7 +40,7 @@ from collidium.observers import (
 from collidium.observers.energy import DRIFT_WARNING, conserved_energy
 from collidium.observers.energy import drift_warning as drift_warning_line
 from collidium.scenario import Scenario, build_observers
-from collidium.simulation import Simulation, restore_with_meta, step_count
+from collidium.simulation import MAX_STEPS, Simulation, restore_with_meta, step_count
 
 #: Trajectory formats by file suffix.
 OUTPUT_SUFFIXES = (".gsd", ".xyz")
@@ -270,12 +270,18 @@ def prepare(
     """
     job = Job(
         end_step=steps_of(spec, time, steps), out=None if out is None else str(out),
-        every=every if every is not None else max(1, round(0.1 / spec.run.dt)),
+        every=every if every is not None else _steps_in_a_tenth_of_a_second(spec.run.dt),
         checkpoint=None if checkpoint is None else str(checkpoint),
         checkpoint_every=checkpoint_every, observers=spec.to_dict().get("observers", []),
         max_drift=max_drift,
     )  # fmt: skip
     return spec.build(), job
+
+
+def _steps_in_a_tenth_of_a_second(dt: float) -> int:
+    """The default frame interval, in steps of ``dt`` (s): 0.1 s, at least a step (at most
+    `MAX_STEPS`: a subnormal dt would overflow the count)."""
+    return max(1, round(min(0.1 / dt, MAX_STEPS)))
 
 
 def record(

@@ -51,6 +51,7 @@ def test_potential_follows_moved_particles():
     [
         ({"k": float("nan")}, "forces.coulomb.k"),
         ({"softening": -1.0}, "forces.coulomb.softening"),
+        ({"softening": 1e300}, "forces.coulomb.softening"),  # its square overflows
         ({"max_acceleration": 0.0}, "forces.coulomb.max_acceleration"),
         ({"method": "fmm"}, "forces.coulomb.method"),
         ({"theta": 1.5}, "forces.coulomb.theta"),
@@ -100,6 +101,7 @@ def test_tree_and_direct_fields_agree_to_the_tree_error():
     )
 
 
+@pytest.mark.slow
 def test_tree_driven_run_conserves_energy():
     """A softened plasma (no collisions) run by tree: leapfrog keeps the total energy to
     O(dt^2), and the tree's small force error must not add a drift of its own. The same run by

@@ -43,3 +43,14 @@ def test_window_of_points_at_one_place_is_the_vessel():
     position = np.zeros((cells.WINDOW_FROM, 2))
     window = cells.grid_window(position, 0.0, (10.0, 10.0), periodic=False)
     np.testing.assert_array_equal(window, [[-5.0, -5.0], [5.0, 5.0]])
+
+
+@pytest.mark.parametrize("diameter", [5e-324, 2.2e-308, 1e-300])
+def test_a_vanishing_diameter_gets_the_fewest_cells_per_particle(diameter):
+    """A diameter so small that the window over it overflows float64 still gets a grid within
+    the budget of about 2 cells per particle."""
+    ncx, ncy = cells.grid_shape(20.0, 20.0, diameter, 20)
+    assert 1 <= ncx * ncy <= 40
+    assert cells.event_grid_shape(20.0, 20.0, diameter, 20) == cells.event_grid_shape(
+        20.0, 20.0, 0.1, 20
+    )

@@ -283,13 +283,14 @@ class ForceField:
             self._acceleration = np.empty((n, 2))
         self._acceleration[...] = 0.0
         potential = virial = 0.0
-        for force, work, carried in zip(self._position, self._work, self._carried, strict=True):
-            force.compute(particles, vessel, self._force, self._energy, self._virial, work)
-            if not carried:
-                self._acceleration += self._force
-            potential += float(np.sum(self._energy))
-            virial += float(np.sum(self._virial))
-        with np.errstate(over="ignore"):  # an infinite acceleration is refused just below
+        # Overflowing forces (infinite, or opposite infinities summed to NaN) are refused below.
+        with np.errstate(over="ignore", invalid="ignore"):
+            for force, work, carried in zip(self._position, self._work, self._carried, strict=True):
+                force.compute(particles, vessel, self._force, self._energy, self._virial, work)
+                if not carried:
+                    self._acceleration += self._force
+                potential += float(np.sum(self._energy))
+                virial += float(np.sum(self._virial))
             np.divide(self._acceleration, particles.mass[:, None], out=self._acceleration)
         _refuse_infinite(self._acceleration)
         self._potential = potential

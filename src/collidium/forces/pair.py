@@ -31,9 +31,19 @@ TREE_CROSSOVER = 500
 DEFAULT_THETA = tree.THETA
 
 
+#: Largest softening length, m: the kernels sum with its square, which must stay a float64.
+MAX_SOFTENING = 1e150
+
+
 def check_sum(name: str, softening: float, method: str, theta: float) -> None:
     """Refuse a bad softening, summation method or opening angle of the force ``name``."""
     check_at_least(name, "softening", softening)
+    if softening > MAX_SOFTENING:
+        raise InputError(
+            f"forces.{name}.softening",
+            f"must be at most {MAX_SOFTENING:g} m (its square must fit a float64), "
+            f"got {softening!r}",
+        )
     if method not in SUM_METHODS:
         raise InputError(f"forces.{name}.method", f"must be one of {SUM_METHODS}, got {method!r}")
     if not (isinstance(theta, int | float) and 0.0 < theta < 1.0):

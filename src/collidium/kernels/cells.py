@@ -14,6 +14,7 @@ the cell next to the window, and disks in contact are still in the same or adjac
 from __future__ import annotations
 
 import math
+import sys
 
 import numba
 import numpy as np
@@ -227,8 +228,9 @@ def grid_shape(width: float, height: float, max_diameter: float, n: int) -> tupl
     at most about 2 cells per particle."""
     if max_diameter <= 0.0:
         return 1, 1
-    ncx = max(1, int(width // max_diameter))
-    ncy = max(1, int(height // max_diameter))
+    # A subnormal diameter overflows the ratio to inf: any count past the budget ends the same.
+    ncx = max(1, int(min(width // max_diameter, sys.float_info.max)))
+    ncy = max(1, int(min(height // max_diameter, sys.float_info.max)))
     budget = max(16, 2 * n)
     while ncx * ncy > budget:
         ncx = max(1, ncx // 2)
