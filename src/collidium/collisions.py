@@ -427,7 +427,7 @@ class ExactCollisions:
         queue = {k.removeprefix("queue/"): v for k, v in arrays.items() if k.startswith("queue/")}
         queue.setdefault("piston", np.empty(0))  # saved before pistons: none
         usable = (
-            set(queue) == set(_QUEUE_ARRAYS) - set(_SLOT_VIEWS) | {"piston"}
+            set(queue) == {*_QUEUE_ARRAYS, "piston"}
             and "synced_at" in arrays
             and int(arrays.get("event_codes", [0])[0]) == _EVENT_CODES
         )
@@ -449,7 +449,7 @@ class ExactCollisions:
             return False
         p = particles
         synced = events.matches(
-            self._synced_at, s["body"], s["ident"], s["geometry"],
+            self._synced_at, s["body"], s["event"], s["geometry"],
             p.position, p.velocity, p.radius, p.mass,
         )  # fmt: skip
         return bool(synced)
@@ -485,7 +485,7 @@ class ExactCollisions:
         s["grid"] = np.array([ncx, ncy, int(vessel.periodic)], dtype=np.int64)
         events.load(
             particles.position, particles.velocity, particles.radius, particles.mass,
-            s["body"], s["ident"],
+            s["body"], s["event"],
         )  # fmt: skip
         s["piston"] = (
             vessel.piston_array(float(piston[0]), float(piston[1]), now)
@@ -519,9 +519,8 @@ class ExactCollisions:
         halt = self._halt
         halt[events.HALT_AFTER] = halt_after
         processed = events.run_events(
-            until, s["body"], s["ident"], particles.image, s["geometry"], s["grid"], s["cell_of"],
-            s["head"], s["next"], s["count"], s["event"], s["keys"], s["items"], s["where"],
-            tally.counts, tally.impulse,
+            until, s["body"], particles.image, s["geometry"], s["grid"], s["head"], s["next"],
+            s["event"], s["keys"], s["items"], tally.counts, tally.impulse,
             _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
             max(1, self.sort_interval * particles.n), halt, vessel.wall_table(), tally.heat,
             vessel.segments(), s["piston"],
@@ -544,7 +543,7 @@ class ExactCollisions:
                 int(halt[events.HALT_PARTNER]),
             )
         strays = events.synchronise(
-            until, s["body"], s["ident"], s["geometry"], s["grid"], particles.position,
+            until, s["body"], s["event"], s["geometry"], s["grid"], particles.position,
             particles.velocity,
         )  # fmt: skip
         tally.piston[...] = _piston_now(s["piston"], until)
@@ -668,8 +667,6 @@ _SLOT_VIEWS = {
 }  # fmt: skip
 
 
-#: The engine's arrays in the order `events.rebuild` and `events.run_events` take them.
-_QUEUE_ARRAYS = (
-    "body", "ident", "geometry", "grid", "cell_of", "head", "next", "count", "event", "keys",
-    "items", "where",
-)  # fmt: skip
+#: The engine's arrays in the order `events.rebuild` takes them (the slot views are taken there,
+#: from ``event``).
+_QUEUE_ARRAYS = ("body", "geometry", "grid", "head", "next", "event", "keys", "items")

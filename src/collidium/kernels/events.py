@@ -120,6 +120,17 @@ def _engine(**options):
     return numba.njit(cache=True, _nrt=False, **options)
 
 
+@_engine(inline="always")
+def _slot_views(event):
+    """The slots' particles, cells, event counts and heap places: columns of ``event``, (N,).
+
+    The engine's entry points take these views here, from ``event``, rather than as arguments:
+    a lone disk's column would be contiguous, another array type to numba, and so another
+    minute-long compilation of the whole engine.
+    """
+    return event[:, IDENT], event[:, CELL], event[:, COUNT], event[:, WHERE]
+
+
 #: Events per particle between two re-sorts of the slots by cell (sorting costs about as much as
 #: one event per particle; neighbours drift apart in memory over tens of events).
 SORT_INTERVAL = 16
@@ -611,13 +622,14 @@ def sort_slots(body, cell_of, event, head, next_, items, where) -> None:
 
 
 @_engine()
-def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event, keys, items,
-            where, segments, piston) -> None:  # fmt: skip
+def rebuild(now, body, geometry, grid, head, next_, event, keys, items, segments, piston) -> None:
     """Start a fresh queue at time ``now`` (s) from positions synchronised at ``now``.
 
-    ``body``'s positions, velocities, radii and masses and ``ident`` are filled by the caller (see
-    `load`); this sets the stamps, sorts the slots by cell and predicts every event.
+    ``body``'s positions, velocities, radii and masses and the slots' particles are filled by
+    the caller (see `load`); this sets the stamps, sorts the slots by cell and predicts every
+    event.
     """
+    ident, cell_of, count, where = _slot_views(event)
     n = body.shape[0]
     ncx = grid[0]
     for k in range(n):
@@ -644,18 +656,14 @@ def rebuild(now, body, ident, geometry, grid, cell_of, head, next_, count, event
 def run_events(
     until: float,
     body: np.ndarray,
-    ident: np.ndarray,
     image: np.ndarray,
     geometry: np.ndarray,
     grid: np.ndarray,
-    cell_of: np.ndarray,
     head: np.ndarray,
     next_: np.ndarray,
-    count: np.ndarray,
     event: np.ndarray,
     keys: np.ndarray,
     items: np.ndarray,
-    where: np.ndarray,
     tally: np.ndarray,
     impulse: np.ndarray,
     acceleration: np.ndarray,
@@ -715,6 +723,7 @@ def run_events(
         if time stopped advancing at particle i: far more events at one instant than simultaneous
         contacts allow, which only a runaway state (huge or infinite velocities) produces.
     """
+    ident, cell_of, count, where = _slot_views(event)
     processed = 0
     halt[HALT_TIME] = math.nan
     n = body.shape[0]
@@ -983,9 +992,9 @@ def _wall_response(outward, pull, lead, forced):
 
 
 @_engine()
-def load(position, velocity, radius, mass, body, ident) -> None:
-    """Fill ``body`` (N, 7), or (N, 5) without radius and mass, and ``ident`` (N,) from the
-    particles, in particle order.
+def load(position, velocity, radius, mass, body, event) -> None:
+    """Fill ``body`` (N, 7), or (N, 5) without radius and mass, and the slots' particles
+    (``event[:, IDENT]``) from the particles, in particle order.
 
     Parameters
     ----------
@@ -1002,11 +1011,11 @@ def load(position, velocity, radius, mass, body, ident) -> None:
         if body.shape[1] > MASS:
             body[i, RADIUS] = radius[i]
             body[i, MASS] = mass[i]
-        ident[i] = i
+        event[i, IDENT] = i
 
 
 @_engine()
-def synchronise(now, body, ident, geometry, grid, position, velocity) -> int:
+def synchronise(now, body, event, geometry, grid, position, velocity) -> int:
     """Write every particle's position at time ``now`` (s) and velocity into ``position`` and
     ``velocity`` (N, 2), by particle; the lazily kept state is untouched so the queue stays
     valid. Returns how many particles are outside the cells' window (they share its edge cells:
@@ -1016,7 +1025,7 @@ def synchronise(now, body, ident, geometry, grid, position, velocity) -> int:
     y1 = y0 + grid[1] * geometry[CELL_HEIGHT]
     strays = 0
     for k in range(body.shape[0]):
-        i = ident[k]
+        i = event[k, IDENT]
         x, y, vx, vy = _at(k, now, body, geometry)
         position[i, 0] = x
         position[i, 1] = y
@@ -1027,11 +1036,11 @@ def synchronise(now, body, ident, geometry, grid, position, velocity) -> int:
 
 
 @_engine()
-def matches(now, body, ident, geometry, position, velocity, radius, mass) -> bool:
+def matches(now, body, event, geometry, position, velocity, radius, mass) -> bool:
     """True if the particles are exactly what `synchronise` wrote at ``now`` (s), with the
     engine's radii and masses: nobody changed them since, and the queue is still valid."""
     for k in range(body.shape[0]):
-        i = ident[k]
+        i = event[k, IDENT]
         x, y, vx, vy = _at(k, now, body, geometry)
         if (
             position[i, 0] != x
