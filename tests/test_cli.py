@@ -355,6 +355,7 @@ def test_run_table_shows_temperature_and_pressure():
         assert label in result.stdout
 
 
+@pytest.mark.slow
 def test_run_effusion_reports_each_species_crossings_and_grahams_ratio():
     result = collidium("run", "effusion", "--time", "30", "--json")
     assert result.returncode == 0, result.stderr
@@ -389,6 +390,7 @@ def test_xyz_output_directly(tmp_path):
     assert (tmp_path / "run.xyz").read_text().count("Lattice=") == 3
 
 
+@pytest.mark.slow
 def test_killed_run_resumes_bitwise(tmp_path):
     """SIGKILL a checkpointed run once its first checkpoint is on disk, resume it, and compare
     the final state and the whole trajectory with the same run never stopped."""

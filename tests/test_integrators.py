@@ -126,6 +126,7 @@ def test_endless_contacts_under_forces_stop_the_run_where_the_step_began():
     np.testing.assert_array_equal(sim.particles.velocity, before.velocity)
 
 
+@pytest.mark.slow
 def test_halving_the_tolerance_quarters_the_error():
     errors = [max_drift(cd.load("orbit", tolerance=tol), 20.0) for tol in (0.004, 0.002, 0.001)]
     for coarse, fine in itertools.pairwise(errors):
@@ -148,6 +149,7 @@ def test_without_forces_the_exact_engine_is_untouched():
     assert adaptive._drift.events == fixed._drift.events
 
 
+@pytest.mark.slow
 def test_substeps_follow_the_dynamics():
     """The point charges need many substeps as they pass through each other, few elsewhere."""
     sim = cd.load("charged-no-collisions")

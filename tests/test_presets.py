@@ -168,6 +168,7 @@ def test_pi_blocks_refuse_digits_beyond_double_precision():
         preset("pi-blocks", digits=9)
 
 
+@pytest.mark.slow
 def test_the_brownian_disk_takes_the_gas_temperature_and_wanders():
     """Equipartition: the heavy disk's mean kinetic energy is the gas's kT (2D, Boltzmann's
     constant 1), within 3 standard errors of block averages; and it diffuses."""
@@ -501,6 +502,7 @@ def test_projectile_falls_on_the_parabola_and_lands_at_the_textbook_range():
     assert sim.counters.wall_hits["bottom"] == 1 and sim.time > landing
 
 
+@pytest.mark.slow
 def test_spectrometer_ions_land_two_radii_from_the_slit():
     """Each ion turns on a half circle of radius m v / (q B) (2, 4 and 6 m) and lands on the
     floor at x = -10 + 2 r. It crosses the field's edge twice, each to O(omega h) in the
@@ -520,6 +522,7 @@ def test_spectrometer_ions_land_two_radii_from_the_slit():
     assert len(landed) == 3
 
 
+@pytest.mark.slow
 def test_drag_disks_reach_their_terminal_velocities():
     """After 10 s (at least 3.3 time constants m / gamma) each disk falls at
     m g / gamma (1 - exp(-t gamma / m)), the exact solution, to the substeps' O(h^2)."""
@@ -530,6 +533,7 @@ def test_drag_disks_reach_their_terminal_velocities():
     np.testing.assert_allclose(-sim.particles.velocity[:, 1], want, rtol=sim.tolerance**2)
 
 
+@pytest.mark.slow
 def test_galaxy_settles_to_virial_equilibrium():
     """A fifth of the galaxy with five times G (the same G M: the same free-fall time, 13 s, and
     speeds): after the collapse the bound cluster's 2 KE / |W| comes to 1 (the virial theorem),

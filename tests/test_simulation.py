@@ -130,6 +130,7 @@ def _worst_error_of_one_collision(dt: float) -> float:
     return worst
 
 
+@pytest.mark.slow
 def test_collision_under_forces_keeps_the_energy_error_second_order():
     """With the fixed step, a single collision's energy error depends on where in the step the
     contact falls, so one run's ratio is noisy; its worst case over the phase is not. Plain
@@ -203,6 +204,7 @@ def _measured_period(trace: Trace) -> float:
     return float(np.interp(2 * math.pi, swept[k - 1 : k + 1], times[k - 1 : k + 1]))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dt", [0.01, 0.005])
 def test_orbit_period_matches_kepler(dt):
     sim = cd.load("orbit", dt=dt)

@@ -28,6 +28,7 @@ def test_linear_drag_alone_decays_the_speed_exactly():
     assert sim.force_heat() == pytest.approx(0.5 * 2.0 * (speed**2 - 25.0), rel=1e-13)
 
 
+@pytest.mark.slow
 def test_terminal_velocity_is_m_g_over_gamma_to_second_order():
     """Each fixed step is ``v -> exp(-lambda h) v + g h exp(-lambda h / 2)`` (lambda = gamma/m):
     its fixed point, reached after 40 time constants, is ``g h / (2 sinh(lambda h / 2))``,
@@ -43,6 +44,7 @@ def test_terminal_velocity_is_m_g_over_gamma_to_second_order():
     assert -sim.particles.velocity[0, 1] == pytest.approx(terminal, rel=sim.tolerance**2 / 24)
 
 
+@pytest.mark.slow
 def test_quadratic_drag_reaches_sqrt_m_g_over_c():
     sim = _falling(QuadraticDrag(c=0.5), mass=2.0, dt=0.01).run(time=30.0)
     assert -sim.particles.velocity[0, 1] == pytest.approx(math.sqrt(2.0 * 1.0 / 0.5), rel=1e-6)

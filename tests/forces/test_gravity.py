@@ -67,6 +67,7 @@ def test_an_eccentric_binary_holds_its_energy_as_the_time_stepping_targets():
     assert worst <= 1e-6
 
 
+@pytest.mark.slow
 def test_a_circular_binary_keeps_its_period():
     """A circle, period ``T = pi d / v`` = 2 pi s: after 4 periods each mass is back where the
     period says, to the O(tolerance^2) phase error per period (7e-4^2 * 2 pi * 4 = 1.2e-5)."""

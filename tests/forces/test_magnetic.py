@@ -66,6 +66,7 @@ def test_adaptive_substeps_follow_the_cyclotron_frequency():
     assert 0.0 < radius / RADIUS - 1 <= sim.tolerance**2 / 24
 
 
+@pytest.mark.slow
 def test_speed_is_kept_to_round_off_with_walls_and_collisions():
     """Ions of both signs and several masses bouncing in a small box for 20 s. Each half
     substep turns every velocity once, rounding its length by about one unit in the last place

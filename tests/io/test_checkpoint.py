@@ -22,8 +22,17 @@ def assert_same_run(a, b):
     assert a.counters == b.counters
 
 
-@pytest.mark.parametrize("collisions", ["exact", "step"])
-@pytest.mark.parametrize("preset", ["gas", "charged-gas", "pool-break"])
+@pytest.mark.parametrize(
+    ("preset", "collisions"),
+    [
+        ("gas", "exact"),
+        pytest.param("gas", "step", marks=pytest.mark.slow),
+        pytest.param("charged-gas", "exact", marks=pytest.mark.slow),
+        pytest.param("charged-gas", "step", marks=pytest.mark.slow),
+        ("pool-break", "exact"),
+        ("pool-break", "step"),
+    ],
+)
 def test_resumed_run_is_bitwise_the_uninterrupted_one(tmp_path, preset, collisions):
     """Exact and step collisions, with and without Coulomb forces, and the exact engine's
     persistent event queue (force-free presets) saved mid-run."""

@@ -35,6 +35,7 @@ def test_drift_sees_the_largest_deviation_over_the_run():
     assert every_step.initial_total == pytest.approx(-0.89, rel=1e-12)  # 0.36 J - 5/4 J
 
 
+@pytest.mark.slow
 def test_series_records_the_orbit_exchanging_kinetic_and_potential_energy():
     sim = cd.load("orbit")
     series = EnergySeries(Every(10))

@@ -11,6 +11,7 @@ from collidium import InputError, load
 from collidium.observers import TemperatureProfile
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("axis", ["x", "y"])
 def test_an_equilibrium_gas_has_a_flat_profile(axis):
     sim = load("gas", seed=5).run(time=20.0)  # relaxed from the uniform start

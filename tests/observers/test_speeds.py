@@ -43,6 +43,7 @@ def test_gas_relaxes_to_maxwell_boltzmann():
     assert error < 0.15 * kT
 
 
+@pytest.mark.slow
 def test_time_averaged_histogram_pins_the_temperature():
     """50 snapshots 1 s apart (6 mean free times) of 1000 disks: a 0.5% fit. (The finite-N
     correction of the microcanonical speed law, 2/N = 0.2%, stays below it.)"""

@@ -58,6 +58,7 @@ def test_ideal_gas_of_points_obeys_pa_equals_nkt():
     assert thermo.virial_pressure() == pytest.approx(ideal, rel=1e-12)  # no collisions, no forces
 
 
+@pytest.mark.slow
 def test_dilute_disk_gas_approaches_the_ideal_gas_with_the_second_virial_correction():
     """At packing 0.05 P A_c / (N kT) = 1.108: the ideal gas plus 2 eta + 3.13 eta^2 + ...; the
     wall pressure resolves that 10% excess."""

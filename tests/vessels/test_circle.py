@@ -123,6 +123,7 @@ def test_checkpoints_in_a_circle_resume_bitwise(tmp_path):
     assert again.run(time=2.0).particles.position.tobytes() == whole.tobytes()
 
 
+@pytest.mark.slow
 def test_a_charged_gas_in_a_circle_holds_its_energy():
     """Contacts of forced disks with the rim fall between substeps too (`Vessel.wall_gap`)."""
     data = gas(n=60, speed=5.0).to_dict()

@@ -151,6 +151,7 @@ def test_free_piston_settles_where_the_gas_pressure_equals_its_weight():
     assert abs(state_equation - force / length) <= 3 * error
 
 
+@pytest.mark.slow
 def test_slow_compression_follows_the_2d_adiabat():
     """A piston driven at 0.02 m/s, about 1% of the thermal speed, halves a dilute gas's
     chamber in 1000 s: P A^2 stays constant within 2% (gamma = 2 in 2D). The gas is dilute

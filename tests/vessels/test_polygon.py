@@ -227,6 +227,7 @@ def test_checkpoints_in_a_polygon_resume_bitwise(tmp_path):
     assert again.run(time=2.0).particles.position.tobytes() == whole.tobytes()
 
 
+@pytest.mark.slow
 def test_a_charged_gas_in_an_l_holds_its_energy():
     """Contacts of forced disks with edges and corners fall between substeps too
     (`Vessel.wall_gap` for segments)."""

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -39,6 +40,7 @@ def test_wall_delay_equals_its_twin_and_ends_on_the_rim(distance, angle, speed, 
                                [x + vx * delay, y + vy * delay], atol=1e-11)  # fmt: skip
 
 
+@pytest.mark.slow
 def test_flight_off_the_rim_equals_bounce_by_bounce_and_keeps_speed_and_angular_momentum(rng):
     n = 200
     radius = rng.uniform(0.0, 0.3, n)
