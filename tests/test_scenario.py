@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 from pydantic import ValidationError
 
 from collidium.errors import InputError
+from collidium.forces.pair import MAX_SOFTENING
 from collidium.presets import preset, presets
 from collidium.scenario import Scenario, apply_overrides, describe, dump_toml
 from collidium.simulation import Simulation
@@ -66,7 +67,11 @@ rack_groups = st.fixed_dictionaries(
 )
 coulombs = st.fixed_dictionaries(
     {"type": st.just("coulomb")},
-    optional={"k": finite, "softening": non_negative, "max_acceleration": positive},
+    optional={
+        "k": finite,
+        "softening": st.floats(0.0, MAX_SOFTENING),
+        "max_acceleration": positive,
+    },
 )
 scenario_dicts = st.fixed_dictionaries(
     {
