@@ -15,7 +15,13 @@ from pydantic import ValidationError
 from collidium.errors import InputError
 from collidium.forces.pair import MAX_SOFTENING
 from collidium.presets import preset, presets
-from collidium.scenario import Scenario, apply_overrides, describe, dump_toml
+from collidium.scenario import (
+    FASTEST_COMPONENT,
+    Scenario,
+    apply_overrides,
+    describe,
+    dump_toml,
+)
 from collidium.simulation import Simulation
 
 # --- strategies ----------------------------------------------------------------------------------
@@ -48,7 +54,7 @@ random_groups = st.fixed_dictionaries(
     optional={
         "mass": positive,
         "radius": non_negative,
-        "speed": non_negative,
+        "speed": st.floats(0.0, FASTEST_COMPONENT, exclude_max=True),
         "charge": finite,
         "charges": st.sampled_from(["same", "balanced"]),
     },
@@ -209,6 +215,7 @@ def test_extra_fields_are_rejected_and_named(path):
         ("particles.0.mass", -1.0, "must be > 0"),
         ("particles.0.radius", -0.1, "must be >= 0"),
         ("particles.0.speed", math.nan, "finite"),
+        ("particles.0.speed", 2.2e8, "below the speed of light"),  # sqrt(2) 2.2e8 > 3e8 m/s
         ("particles.0.charges", "random", "'same' or 'balanced'"),
         ("forces.0.softening", -0.5, "must be >= 0"),
         ("forces.0.max_acceleration", 0.0, "must be > 0"),

@@ -24,6 +24,13 @@ def test_scalars_broadcast_and_velocity_defaults_to_rest():
     [
         ({"position": [[0.0, np.nan]]}, "position", "not finite"),
         ({"position": [[0.0, 0.0]], "velocity": [[np.inf, 0.0]]}, "velocity", "not finite"),
+        # Light's speed, m/s, along a diagonal: Newtonian mechanics only below it.
+        (
+            {"position": [[0, 0], [1, 0]], "velocity": [[0, 0], [2.12e8, 2.12e8]]},
+            "velocity",
+            "particle 1 moves at 3e+08 m/s, not below the speed of light",
+        ),
+        ({"position": [[0.0, 0.0]], "velocity": [[1e300, 1e300]]}, "velocity", "at inf m/s"),
         ({"position": [[0.0, 0.0]], "mass": 0.0}, "mass", "> 0"),
         ({"position": [[0.0, 0.0]], "mass": [-1.0]}, "mass", "> 0"),
         ({"position": [[0.0, 0.0]], "radius": -0.1}, "radius", ">= 0"),

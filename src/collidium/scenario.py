@@ -75,6 +75,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, Union, get_origin
 import numpy as np
 import tomli_w
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Discriminator,
@@ -117,7 +118,7 @@ from collidium.observers import (
     VirialRatio,
 )
 from collidium.simulation import Simulation, outside_detail, overlap_detail
-from collidium.state import FloatArray, Particles, uniform_or_each
+from collidium.state import SPEED_OF_LIGHT, FloatArray, Particles, uniform_or_each
 from collidium.vessels import (
     VESSELS,
     Box,
@@ -135,6 +136,22 @@ from collidium.vessels import (
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+#: Fastest velocity component a group may be given, m/s: the fastest disk then moves at up to
+#: sqrt(2) times it, still below the speed of light (the mechanics is Newtonian).
+FASTEST_COMPONENT = SPEED_OF_LIGHT / math.sqrt(2.0)
+
+
+def _below_light(speed: float) -> float:
+    if speed >= FASTEST_COMPONENT:
+        raise ValueError(
+            f"must be below {FASTEST_COMPONENT:.4g} m/s (velocity components up to it make speeds "
+            f"up to sqrt(2) times it, below the speed of light), got {speed!r}"
+        )
+    return speed
+
+
+#: A group's speed scale in m/s: its velocity components are at most this.
+Speed = Annotated[NonNegative, AfterValidator(_below_light)]
 Vector = Annotated[list[Finite], Field(min_length=2, max_length=2)]
 
 #: Largest particle count of one random group (keeps a typo from exhausting memory).
@@ -640,7 +657,7 @@ class RandomGroup(_Model):
     n: Annotated[int, Field(ge=0, le=MAX_GROUP_SIZE)]
     mass: Positive = 1.0
     radius: NonNegative = 0.25
-    speed: NonNegative = 0.0
+    speed: Speed = 0.0
     charge: Finite = 0.0
     charges: Literal["same", "balanced"] = "same"
     region: Annotated[list[Vector], Field(min_length=2, max_length=2)] | None = None
@@ -722,7 +739,7 @@ class LatticeGroup(_Model):
     packing: Annotated[float, Field(gt=0.0, le=CLOSE_PACKING)]
     radius: Positive = 0.5
     mass: Positive = 1.0
-    speed: NonNegative = 0.0
+    speed: Speed = 0.0
     charge: Finite = 0.0
     origin: Vector | None = None
 

@@ -695,8 +695,10 @@ def _check_kinetic_energy(particles: Particles) -> None:
         total = float(np.sum(energy))
     if not math.isfinite(total):
         fastest = float(np.abs(particles.velocity).max(initial=0.0))
+        heaviest = float(particles.mass.max(initial=0.0))
         raise InputError("particles.velocity", f"the kinetic energy overflows float64 (a velocity "
-                                               f"component of {fastest:.3g} m/s)")  # fmt: skip
+                                               f"component of {fastest:.3g} m/s, masses up to "
+                                               f"{heaviest:.3g} kg)")  # fmt: skip
 
 
 def _check_forces(forces: Sequence[Force], container: Vessel, particles: Particles) -> None:

@@ -13,6 +13,9 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 
+#: The speed of light, m/s: collidium's mechanics is Newtonian, for particles slower than this.
+SPEED_OF_LIGHT = 299_792_458.0
+
 
 def _per_particle(name: str, value: ArrayLike, n: int) -> FloatArray:
     """A length-N sequence as a fresh (N,) float64 array; a scalar as the value all N particles
@@ -32,6 +35,20 @@ def _per_particle(name: str, value: ArrayLike, n: int) -> FloatArray:
         sign = ">" if name == "mass" else ">="
         raise InputError(name, f"must be {sign} 0, particle {i} has {float(values[i])!r}")
     return np.broadcast_to(array, (n,)) if array.ndim == 0 else array
+
+
+def _check_slower_than_light(velocity: FloatArray) -> None:
+    """Refuse a velocity (N, 2) at or past the speed of light, naming the first such particle."""
+    with np.errstate(over="ignore"):  # a square past float64 is past light too
+        speed2 = np.einsum("ij,ij->i", velocity, velocity)
+    fast = np.flatnonzero(speed2 >= SPEED_OF_LIGHT**2)
+    if fast.size:
+        i = int(fast[0])
+        raise InputError(
+            "velocity",
+            f"particle {i} moves at {float(np.sqrt(speed2[i])):.3g} m/s, not below the speed "
+            f"of light ({SPEED_OF_LIGHT:.0f} m/s): the mechanics is Newtonian",
+        )
 
 
 def _check_finite(name: str, values: FloatArray) -> None:
@@ -98,8 +115,8 @@ class Particles:
     Raises
     ------
     InputError
-        On a wrong shape, NaN or infinity, mass <= 0 or radius < 0. Overlaps and the vessel are
-        checked by `Simulation`, which knows the container.
+        On a wrong shape, NaN or infinity, a speed not below light's, mass <= 0 or radius < 0.
+        Overlaps and the vessel are checked by `Simulation`, which knows the container.
     """
 
     position: FloatArray
@@ -125,6 +142,7 @@ class Particles:
             raise InputError("velocity", f"expected shape ({n}, 2), got {self.velocity.shape}")
         _check_finite("position", self.position)
         _check_finite("velocity", self.velocity)
+        _check_slower_than_light(self.velocity)
         self.mass = mass
         self.radius = radius
         self.charge = charge
