@@ -160,7 +160,8 @@ PISTON_STEP = (
         (["run", "gas", "--set", "n=" + "9" * 5000], None, "n"),
         (["run", "gas", "--set", "x=" + "[" * 3000 + "]" * 3000], None, "x"),
         (["run", "gas", "--set", "width=1e308", "--set", "height=1e308"], None, "vessel.width"),
-        (["run", "gas", "--set", "speed=1e308"], None, "particles.velocity"),
+        (["run", "gas", "--set", "speed=1e308"], None, "speed"),  # past light's
+        (["run", "gas", "--set", "mass=1e300", "--set", "speed=1e8"], None, "particles.velocity"),
         (["run", "/dev/zero"], None, "/dev/zero"),
         (["run", "gas", "--set", "name=0"], None, "name"),  # not the preset's own name
         (["run", "effusion", "--set", "gap=30"], None, "vessel.partitions.divider.gap"),
