@@ -47,8 +47,8 @@ DEFAULT_TOLERANCE = 0.0007
 MAX_SUBSTEPS = 2**14
 
 #: Most contacts under forces in one reporting interval: each shortens a substep and costs a force
-#: evaluation, so one more stops the run with one line (a particle at 1e9 m/s in a 20 m box hits
-#: its walls a million times in a dt of 0.01 s, hours of substeps).
+#: evaluation, so one more stops the run with one line (a disk at 1e8 m/s in a 20 m box hits its
+#: walls 50000 times in a dt of 0.01 s: minutes of substeps for every dt).
 MAX_CONTACTS = 2**14
 
 #: The energy scale of the substep criterion is the total energy, but at least ``KE + |U|``
