@@ -232,7 +232,7 @@ class AdaptiveLeapfrog(Integrator):
         while True:
             try:
                 fastest = self._interval(particles, vessel, field, drift, now, dt, tally, n, rate2)
-            except SimulationError:  # too many contacts: the run stops where the interval began
+            except SimulationError:  # any stop inside the interval leaves the state it began from
                 start.restore(particles, tally)
                 field.evaluate(particles, vessel)
                 raise
