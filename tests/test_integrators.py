@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import collidium as cd
+from collidium import integrators
 from collidium.collisions import Contact
 from collidium.errors import InputError, SimulationError
 from collidium.integrators import (
@@ -19,6 +20,8 @@ from collidium.integrators import (
     AdaptiveLeapfrog,
     _shortened,
 )
+from collidium.kernels import substeps
+from collidium.kernels.pairwise import PARALLEL_DIRECT_FROM as PARALLEL_ROWS
 from collidium.observers import EnergyDrift
 
 
@@ -208,3 +211,60 @@ def test_bad_integrator_settings_name_the_field(field, value):
     with pytest.raises(InputError) as caught:
         cd.load("orbit", **{field: value})
     assert caught.value.field in (field, f"run.{field}")
+
+
+@pytest.mark.parametrize(
+    ("name", "time", "atol"),
+    [
+        ("orbit", 2.0, 1e-12),
+        ("bohr-atom", 1.0, 1e-12),
+        ("charged-opposite", 4.0, 1e-12),  # they collide three times
+        ("charged-gas", 0.1, 1e-10),  # 200 disks, a contact in most regular substeps
+    ],
+)
+def test_compiled_substeps_give_the_python_run_to_round_off(monkeypatch, name, time, atol):
+    """The substeps that meet no contact, flown in one compiled call, give the run of one
+    Python call per substep: the same substep counts and contacts, the motion to round-off
+    (the exact engine advances a disk at each cell crossing; ``atol`` in m and m/s allows for
+    the growth of that round-off in the gas)."""
+    taken = []
+    kernel = substeps.smooth_substeps
+
+    def counting(*args):
+        out = kernel(*args)
+        taken.append(out[0] - args[-6])  # substeps flown: the one reached less the first
+        return out
+
+    monkeypatch.setattr(substeps, "smooth_substeps", counting)
+    compiled = cd.load(name).run(time=time)
+    assert sum(taken) > 0.5 * compiled.steps * compiled._integrator.substeps
+    monkeypatch.setattr(integrators._SmoothFlight, "of", classmethod(lambda cls, *args: None))
+    python = cd.load(name).run(time=time)
+    assert compiled._integrator.substeps == python._integrator.substeps
+    assert compiled.counters == python.counters
+    np.testing.assert_allclose(compiled.particles.position, python.particles.position, atol=atol)
+    np.testing.assert_allclose(compiled.particles.velocity, python.particles.velocity, atol=atol)
+
+
+def smooth_flight(sim: cd.Simulation) -> object:
+    """The compiled substeps' part of a simulation's scene, or None."""
+    return integrators._SmoothFlight.of(sim.particles, sim.container, sim._field)
+
+
+def test_compiled_substeps_take_direct_pair_sums_between_fixed_walls():
+    assert smooth_flight(cd.load("orbit")) is not None
+    assert smooth_flight(cd.load("charged-gas")) is not None
+    sim = cd.load("orbit")
+    sim.forces = [cd.Coulomb(), cd.Newton(G=1.0)]
+    assert smooth_flight(sim) is not None
+    excluded = {
+        "a tree sum": [cd.Coulomb(method="tree")],
+        "a limiter": [cd.Coulomb(max_acceleration=10.0)],
+        "a velocity force": [cd.Coulomb(), cd.MagneticField(B=1.0)],
+        "an external field": [cd.Coulomb(), cd.UniformField(E=[1.0, 0.0])],
+    }
+    for forces in excluded.values():
+        sim.forces = forces
+        assert smooth_flight(sim) is None
+    assert smooth_flight(cd.load("charged-gas", boundary="periodic")) is None
+    assert smooth_flight(cd.load("charged-gas", n=PARALLEL_ROWS)) is None  # rows on threads

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -29,6 +30,8 @@ import numpy as np
 from collidium.collisions import Contact, Drift, Tally
 from collidium.errors import SimulationError
 from collidium.forces import ForceField
+from collidium.kernels import substeps
+from collidium.kernels.pairwise import PARALLEL_DIRECT_FROM
 from collidium.state import FloatArray, Particles
 from collidium.vessels import Vessel
 
@@ -222,7 +225,12 @@ class AdaptiveLeapfrog(Integrator):
         tally: Tally,
     ) -> None:
         start = _Snapshot(particles, tally)
-        rate2 = _squared_rate(particles, vessel, field)
+        flight = _SmoothFlight.of(particles, vessel, field)
+        rate2 = (
+            _squared_rate(particles, vessel, field)
+            if flight is None
+            else flight.squared_rate(particles, field)
+        )
         if not dt * math.sqrt(rate2) <= MAX_SUBSTEPS * self.tolerance:  # also NaN
             raise SimulationError(
                 f"the forces need more than {MAX_SUBSTEPS} substeps in one dt = {dt:g} s at "
@@ -231,7 +239,9 @@ class AdaptiveLeapfrog(Integrator):
         n = max(self.substeps, self.needed(rate2, dt))
         while True:
             try:
-                fastest = self._interval(particles, vessel, field, drift, now, dt, tally, n, rate2)
+                fastest = self._interval(
+                    particles, vessel, field, drift, flight, now, dt, tally, n, rate2
+                )
             except SimulationError:  # any stop inside the interval leaves the state it began from
                 start.restore(particles, tally)
                 field.evaluate(particles, vessel)
@@ -250,19 +260,26 @@ class AdaptiveLeapfrog(Integrator):
         vessel: Vessel,
         field: ForceField,
         drift: Drift,
+        flight: _SmoothFlight | None,
         now: float,
         dt: float,
         tally: Tally,
         n: int,
         fastest: float,
     ) -> float:
-        """Take the interval in ``n`` regular substeps (each split at contacts); returns the
-        largest squared rate (1/s^2) met at their boundaries (the regular ones: they are the same
-        forwards and backwards, and contacts come with their own substep boundaries), starting
-        from ``fastest``, the interval's start's (`_squared_rate`)."""
+        """Take the interval in ``n`` regular substeps (each split at contacts), those that meet
+        no contact by the compiled ``flight`` where there is one; returns the largest squared
+        rate (1/s^2) met at their boundaries (the regular ones: they are the same forwards and
+        backwards, and contacts come with their own substep boundaries), starting from
+        ``fastest``, the interval's start's (`_squared_rate`)."""
         t = now
         contacts = 0
-        for s in range(1, n + 1):
+        s = 1
+        while s <= n:
+            if flight is not None:  # as many substeps as meet no contact, compiled
+                s, t, fastest = flight.substeps(particles, field, now, dt, s, n, t, fastest)
+                if s > n:
+                    break
             end = now + dt * s / n
             while t < end:  # substeps shortened for contacts end at a contact, not at ``end``
                 t = self._substep(particles, vessel, field, drift, t, end, dt, tally)
@@ -274,6 +291,7 @@ class AdaptiveLeapfrog(Integrator):
                         f'collisions = "step"'
                     )
             fastest = max(fastest, _squared_rate(particles, vessel, field))
+            s += 1
         return fastest
 
     def _substep(
@@ -342,8 +360,7 @@ def _squared_rate(particles: Particles, vessel: Vessel, field: ForceField) -> fl
     the energy by about ``h^2 rate^2`` of that scale. The velocity forces' own rate
     (`ForceField.rate`) counts too: a substep turns or damps a velocity by at most
     ``tolerance`` of it."""
-    p = particles
-    kinetic = 0.5 * float(np.sum(p.mass * np.einsum("ij,ij->i", p.velocity, p.velocity)))
+    kinetic = substeps.kinetic_energy(particles.mass, particles.velocity)
     potential = field.potential(particles, vessel)
     scale = max(abs(kinetic + potential), (kinetic + abs(potential)) / TOTAL_ENERGY_FLOOR)
     energy = math.sqrt(field.stiffness(particles, vessel)) / scale if scale > 0.0 else 0.0
@@ -414,6 +431,64 @@ def _newton(
         if abs(step) <= 1e-15 * abs(s):
             return s
     return s if math.isfinite(s) else math.nan
+
+
+@dataclass(frozen=True)
+class _SmoothFlight:
+    """A scene's part in the compiled contact-free substeps (`collidium.kernels.substeps`):
+    masses, radii, the pair forces' terms and the vessel as the exact engine has it."""
+
+    mass: FloatArray
+    radius: FloatArray
+    terms: tuple[FloatArray, FloatArray, FloatArray]
+    walls: tuple[int, float, float, float, FloatArray]
+
+    @classmethod
+    def of(cls, particles: Particles, vessel: Vessel, field: ForceField) -> _SmoothFlight | None:
+        """The scene's part, or None unless the vessel has walls (not periodic), the particles
+        are few enough for one thread (`PARALLEL_DIRECT_FROM`) and every force is a direct pair
+        sum (`ForceField.direct_terms`; a vessel with a piston has no such force). A substep
+        that meets no contact is a straight flight in every collision mode."""
+        if vessel.periodic or particles.n >= PARALLEL_DIRECT_FROM:
+            return None
+        terms = field.direct_terms(particles, vessel)
+        if terms is None:
+            return None
+        half_width, half_height = (0.5 * float(side) for side in vessel.extent)
+        walls = (vessel.shape_code, half_width, half_height, vessel.rim, vessel.segments())
+        # Contiguous copies: a shared mass or radius is a stride-0 view, which would compile the
+        # substeps a second time.
+        return cls(
+            np.ascontiguousarray(particles.mass),
+            np.ascontiguousarray(particles.radius),
+            terms,
+            walls,
+        )
+
+    def squared_rate(self, particles: Particles, field: ForceField) -> float:
+        """`_squared_rate` of the current state, compiled (the same to round-off)."""
+        _, _, rate2 = self.substeps(particles, field, 0.0, 0.0, 1, 0, 0.0, -1.0)
+        return rate2
+
+    def substeps(
+        self,
+        particles: Particles,
+        field: ForceField,
+        now: float,
+        dt: float,
+        first: int,
+        count: int,
+        t: float,
+        fastest: float,
+    ) -> tuple[int, float, float]:
+        """Regular substeps from ``first`` of ``count`` up to the first that may meet a
+        contact (`collidium.kernels.substeps.smooth_substeps`): ``(that substep, its start in
+        s, the largest squared rate)``. The field's acceleration is kept current; its energies
+        are evaluated again when read."""
+        return substeps.smooth_substeps(
+            particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
+            *self.terms, *self.walls, now, dt, first, count, t, fastest, TOTAL_ENERGY_FLOOR,
+        )  # fmt: skip
 
 
 class _Snapshot:

@@ -92,6 +92,18 @@ class VelocityForce(Force, Protocol):
         inverse; 0 where the flow is exact whatever the substep."""
 
 
+@runtime_checkable
+class DirectPairForce(PositionForce, Protocol):
+    """A position force that may be an inverse-distance pair sum the compiled substeps can do
+    (`collidium.kernels.substeps`)."""
+
+    def direct_term(
+        self, particles: Particles, vessel: Vessel
+    ) -> tuple[FloatArray, float, float] | None:
+        """``(sources (N,), coupling, squared softening in m^2)`` when the force is exactly the
+        direct inverse-distance sum of `collidium.kernels.pairwise` here, else None."""
+
+
 #: Every force by its name (filled as the force modules are imported).
 FORCES: dict[str, type[Force]] = {}
 
@@ -236,6 +248,8 @@ class ForceField:
         self._velocity = tuple(f for f in self.forces if isinstance(f, VelocityForce))
         #: Per position force: whether the drift carries it (no kicks).
         self._carried = tuple(carry_fall and f.fall is not None for f in self._position)
+        #: Whether every position force may be a direct pair sum (a protocol check is slow).
+        self._direct = all(isinstance(f, DirectPairForce) for f in self._position)
         self._fall = np.zeros(2)
         for force, carried in zip(self._position, self._carried, strict=True):
             if carried:
@@ -297,6 +311,23 @@ class ForceField:
         self._virial_sum = virial
         self._evaluated_at = particles.position.copy()
         return self._acceleration
+
+    def direct_terms(
+        self, particles: Particles, vessel: Vessel
+    ) -> tuple[FloatArray, FloatArray, FloatArray] | None:
+        """The forces as the compiled substeps sum them (`collidium.kernels.substeps`): sources
+        (F, N), couplings (F,) and squared softenings (F,) m^2, when every force is a direct
+        inverse-distance pair sum (`DirectPairForce.direct_term`); None otherwise."""
+        if self._velocity or not self._position or not self._direct:
+            return None
+        terms = []
+        for force in self._position:
+            term = typing.cast(DirectPairForce, force).direct_term(particles, vessel)
+            if term is None:
+                return None
+            terms.append(term)
+        sources, couplings, softening2 = zip(*terms, strict=True)
+        return np.stack(sources), np.array(couplings), np.array(softening2)
 
     def stiffness(self, particles: Particles, vessel: Vessel) -> float:
         """``S`` of all forces at the current state, in J^2/s^4: the largest of the forces'

@@ -84,6 +84,14 @@ class Coulomb(InverseDistanceForce):
             pull = np.hypot(force[:, 0], force[:, 1]) / particles.mass
             force /= np.sqrt(1.0 + (pull / self.max_acceleration) ** 2)[:, None]
 
+    def direct_term(
+        self, particles: Particles, vessel: Vessel
+    ) -> tuple[FloatArray, float, float] | None:
+        """The direct sum's terms (`InverseDistanceForce.direct_term`), none with a limiter."""
+        if self.max_acceleration is not None:
+            return None
+        return super().direct_term(particles, vessel)
+
     def to_dict(self) -> dict[str, object]:
         """Parameters as in a scenario file (defaults of the optional ones omitted)."""
         out: dict[str, object] = {"type": self.name, "k": self.k, "softening": self.softening}

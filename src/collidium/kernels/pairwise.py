@@ -192,7 +192,7 @@ def _sources(position, source, force, energy, virial):
 
 
 @numba.njit(cache=True, inline="always")
-def _direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force, energy,
+def direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force, energy,
                 virial) -> None:  # fmt: skip
     """Row c of `inverse_distance_direct`: the sums over ``j < c`` then ``j > c``, written to
     the particle ``index[c]``."""
@@ -217,7 +217,7 @@ def direct_parallel(position, source, coupling, softening2, width, height, perio
     """`inverse_distance_direct`'s rows in parallel."""
     x, y, q, index = _sources(position, source, force, energy, virial)
     for c in numba.prange(x.shape[0]):
-        _direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force,
+        direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force,
                     energy, virial)  # fmt: skip
 
 
@@ -227,12 +227,12 @@ def direct_serial(position, source, coupling, softening2, width, height, periodi
     """`inverse_distance_direct`'s rows on the calling thread."""
     x, y, q, index = _sources(position, source, force, energy, virial)
     for c in range(x.shape[0]):
-        _direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force,
+        direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force,
                     energy, virial)  # fmt: skip
 
 
 @numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def _stiffness_row(
+def stiffness_row(
     c: int,
     x: np.ndarray,
     y: np.ndarray,
@@ -294,7 +294,7 @@ def stiffness_parallel(position, velocity, source, mass, coupling, softening2, w
     m = x.shape[0]
     rows = np.zeros(m)
     for c in numba.prange(m):
-        rows[c] = _stiffness_row(
+        rows[c] = stiffness_row(
             c, x, y, vx, vy, q, inverse_mass, coupling, softening2, width, height, periodic
         )
     return rows.max() if m else 0.0
@@ -307,7 +307,7 @@ def stiffness_serial(position, velocity, source, mass, coupling, softening2, wid
     x, y, vx, vy, q, inverse_mass = _moving_sources(position, velocity, source, mass)
     stiffness = 0.0
     for c in range(x.shape[0]):
-        row = _stiffness_row(c, x, y, vx, vy, q, inverse_mass, coupling, softening2, width, height,
+        row = stiffness_row(c, x, y, vx, vy, q, inverse_mass, coupling, softening2, width, height,
                              periodic)  # fmt: skip
         stiffness = max(stiffness, row)
     return stiffness

@@ -799,3 +799,79 @@ def piston_drift(
                 mass[i], mass[j], sep, np.zeros(2), velocity[i], velocity[j]
             )
             pairs += 1
+
+
+def smooth_substeps(
+    position: FloatArray,
+    velocity: FloatArray,
+    acceleration: FloatArray,
+    mass: FloatArray,
+    radius: FloatArray,
+    sources: FloatArray,
+    couplings: FloatArray,
+    softening2: FloatArray,
+    shape: int,
+    half: FloatArray,
+    rim: float,
+    table: FloatArray,
+    now: float,
+    dt: float,
+    first: int,
+    count: int,
+    t: float,
+    fastest: float,
+    energy_floor: float,
+    margin: float,
+) -> tuple[int, float, float]:
+    """Twin of `substeps.smooth_substeps` in a box of half sides ``half`` (``shape`` `BOX`), a
+    circle of radius ``rim`` (`CIRCLE`) or neither, and against the segments of ``table``.
+
+    Each substep: the kick; the contact test on all pairs and walls at once (contacts within
+    ``margin`` of a radius, or of the substep); the straight flight; the forces
+    (`inverse_distance_direct`); the squared rate from the energies and
+    `inverse_distance_stiffness`. Updates the motion in place and returns ``(substep not
+    taken, its start, fastest)``.
+    """
+    zero = np.zeros(2)
+    for s in range(first, count + 1):
+        end = now + dt * s / count
+        h = end - t
+        kicked = velocity + 0.5 * h * acceleration
+        wide = radius * (1.0 + margin)
+        wall = math.inf
+        if shape == CIRCLE:
+            wall = _next_rim(position, kicked, wide, rim, zero)[0]
+        elif shape == BOX:
+            wall = _next_wall(position, kicked, wide, half)[0]
+        wall = min(wall, _next_segment(position, kicked, wide, table, zero)[0])
+        d = position[None, :, :] - position[:, None, :]  # x_j - x_i
+        w = kicked[None, :, :] - kicked[:, None, :]
+        w2 = np.einsum("ijk,ijk->ij", w, w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            along = np.clip(-np.einsum("ijk,ijk->ij", d, w) / w2, 0.0, h * (1.0 + margin))
+        closest = d + w * np.nan_to_num(along)[:, :, None]
+        sigma = (radius[:, None] + radius[None, :]) * (1.0 + margin)
+        meets = (np.einsum("ijk,ijk->ij", closest, closest) <= sigma**2) & (sigma > 0)
+        if not np.isfinite(kicked).all() or wall <= h * (1.0 + margin) or np.triu(meets, 1).any():
+            return s, t, fastest
+        flown = position + kicked * h
+        force, potential = np.zeros_like(position), 0.0
+        for source, coupling, eps2 in zip(sources, couplings, softening2, strict=True):
+            f, u, _ = inverse_distance_direct(flown, source, coupling, eps2)
+            force += f
+            potential += float(u.sum())
+        pull = force / mass[:, None]
+        if not np.isfinite(pull).all():
+            return s, t, fastest
+        position[...] = flown
+        velocity[...] = kicked + 0.5 * h * pull
+        acceleration[...] = pull
+        t = end
+        stiffness = max(
+            inverse_distance_stiffness(position, velocity, source, mass, coupling, eps2)
+            for source, coupling, eps2 in zip(sources, couplings, softening2, strict=True)
+        )
+        kinetic = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1)))
+        scale = max(abs(kinetic + potential), (kinetic + abs(potential)) / energy_floor)
+        fastest = max(fastest, math.sqrt(stiffness) / scale if scale > 0.0 else 0.0)
+    return count + 1, t, fastest

@@ -1,0 +1,122 @@
+"""The compiled contact-free substeps against their NumPy twin, and where they stop."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from collidium import Polygon
+from collidium.kernels import reference
+from collidium.kernels.substeps import CONTACT_MARGIN, kinetic_energy, smooth_substeps
+from collidium.kernels.vessels import BOX, CIRCLE, POLYGON
+
+FLOOR = 10.0
+NONE = np.empty((0, 9))
+HEXAGON = Polygon([[6.0 * np.cos(a), 6.0 * np.sin(a)] for a in np.arange(6) * np.pi / 3])
+
+
+def scene(rng, n, spread=3.0, speed=1.0):
+    """Disks of radius 0.1 on a jittered ring (none touching), random masses, charges of both
+    signs as the first force's sources and the masses as a second's (Newton's, G = 0.5)."""
+    angle = np.arange(n) * 2 * np.pi / n
+    position = spread * np.column_stack([np.cos(angle), np.sin(angle)])
+    position += rng.uniform(-0.2, 0.2, position.shape)
+    velocity = rng.normal(0.0, speed, (n, 2))
+    mass = rng.uniform(0.5, 2.0, n)
+    radius = np.full(n, 0.1)
+    charge = rng.choice([-1.0, 0.0, 1.0], n)
+    sources = np.ascontiguousarray(np.stack([charge, mass]))
+    return position, velocity, mass, radius, sources, np.array([5.0, -0.5]), np.array([0.01, 0.0])
+
+
+def accelerations(position, mass, sources, couplings, softening2):
+    force = sum(
+        reference.inverse_distance_direct(position, q, c, e)[0]
+        for q, c, e in zip(sources, couplings, softening2, strict=True)
+    )
+    return force / mass[:, None]
+
+
+WALLS = {
+    "box": (BOX, np.array([5.0, 5.0]), np.nan, NONE),
+    "circle": (CIRCLE, np.array([5.0, 5.0]), 5.0, NONE),
+    "hexagon": (POLYGON, 0.5 * HEXAGON.extent, np.nan, HEXAGON.segments()),
+}
+
+
+@pytest.mark.parametrize("vessel", WALLS)
+@pytest.mark.parametrize("speed", [0.5, 40.0])
+def test_substeps_equal_their_twin(rng, vessel, speed):
+    """Slow disks take every substep of 0.1 s; fast ones, 4 m in it, stop where the twin
+    stops, at a wall or a pair."""
+    shape, half, rim, table = WALLS[vessel]
+    position, velocity, mass, radius, sources, couplings, softening2 = scene(rng, 12, speed=speed)
+    acceleration = accelerations(position, mass, sources, couplings, softening2)
+    got = [a.copy() for a in (position, velocity, acceleration)]
+    want = [a.copy() for a in (position, velocity, acceleration)]
+    step, t, fastest = smooth_substeps(*got, mass, radius, sources, couplings, softening2, shape,
+                                       half[0], half[1], rim, table, 1.0, 0.1, 1, 16, 1.0, 0.0,
+                                       FLOOR)  # fmt: skip
+    twin = reference.smooth_substeps(*want, mass, radius, sources, couplings, softening2, shape,
+                                     half, rim, table, 1.0, 0.1, 1, 16, 1.0, 0.0, FLOOR,
+                                     CONTACT_MARGIN)  # fmt: skip
+    assert (step, t) == twin[:2]
+    assert (step == 17) == (speed < 1.0)
+    assert step > 1 or speed > 1.0  # the fast disks too take some substeps first
+    np.testing.assert_allclose(fastest, twin[2], rtol=1e-12)
+    for ours, theirs in zip(got, want, strict=True):
+        np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-12)
+
+
+def test_a_disk_bound_for_a_wall_stops_the_substeps_just_before_it():
+    """A neutral disk at 10 m/s, 1 m from a wall: substeps of 0.01 s take it to 0.1 m short
+    and stop before the one that would reach it; nothing of that substep is kept."""
+    position = np.array([[3.9, 0.0], [-3.0, 0.0]])
+    velocity = np.array([[10.0, 0.0], [0.0, 0.0]])
+    acceleration = np.zeros((2, 2))
+    mass, radius = np.ones(2), np.array([0.1, 0.1])
+    sources = np.zeros((1, 2))
+    step, t, _ = smooth_substeps(position, velocity, acceleration, mass, radius, sources,
+                                 np.array([5.0]), np.zeros(1), BOX, 5.0, 5.0, np.nan, NONE, 0.0,
+                                 0.16, 1, 16, 0.0, 0.0, FLOOR)  # fmt: skip
+    # The wall's contact is at x = 4.9, 0.1 s on: substeps 1 to 9 end at 0.09 s.
+    assert (step, t) == (10, pytest.approx(0.09, rel=1e-15))
+    np.testing.assert_allclose(position[0], [3.9 + 0.9, 0.0], rtol=1e-14)
+    np.testing.assert_array_equal(velocity[0], [10.0, 0.0])
+
+
+@pytest.mark.parametrize("miss", [0.5 * CONTACT_MARGIN, 2 * CONTACT_MARGIN])
+def test_a_grazing_pair_stops_the_substeps_within_the_margin(miss):
+    """Two disks that pass at a distance ``(1 + miss) sigma``: within the margin they stop the
+    substeps, beyond it they fly on."""
+    sigma = 0.2
+    position = np.array([[-1.0, 0.5 * sigma * (1 + miss)], [1.0, -0.5 * sigma * (1 + miss)]])
+    velocity = np.array([[5.0, 0.0], [-5.0, 0.0]])
+    args = (np.zeros((2, 2)), np.ones(2), np.full(2, 0.5 * sigma), np.zeros((1, 2)),
+            np.array([5.0]), np.zeros(1), BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.4, 1, 4, 0.0, 0.0,
+            FLOOR)  # fmt: skip
+    step, _, _ = smooth_substeps(position, velocity, *args)
+    assert step == (5 if miss > CONTACT_MARGIN else 2)  # they meet in the second 0.1 s
+
+
+def test_infinite_accelerations_stop_the_substeps_with_nothing_changed():
+    """A charge of 1e-310 kg beside another: the first substep's accelerations are infinite,
+    so it is left to the integrator, which names the particle."""
+    position = np.array([[-1.0, 0.0], [1.0, 0.0]])
+    velocity = np.zeros((2, 2))
+    acceleration = np.zeros((2, 2))
+    before = position.copy()
+    step, t, fastest = smooth_substeps(position, velocity, acceleration, np.array([1e-310, 1.0]),
+                                       np.zeros(2), np.ones((1, 2)), np.array([5.0]), np.zeros(1),
+                                       BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.1, 1, 4, 0.0, 0.0,
+                                       FLOOR)  # fmt: skip
+    assert (step, t, fastest) == (1, 0.0, 0.0)
+    np.testing.assert_array_equal(position, before)
+    np.testing.assert_array_equal(velocity, 0.0)
+
+
+def test_kinetic_energy_is_half_m_v_squared(rng):
+    mass = rng.uniform(0.5, 2.0, 50)
+    velocity = rng.normal(0.0, 3.0, (50, 2))
+    want = 0.5 * np.sum(mass * np.sum(velocity**2, axis=1))
+    assert kinetic_energy(mass, velocity) == pytest.approx(want, rel=1e-14)
