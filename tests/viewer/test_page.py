@@ -245,15 +245,21 @@ def test_click_traces_a_disk_and_drag_gives_it_a_velocity(page):
     before = pixels(page, "#overlay")
     page.click("#play")
     page.wait_for_function("Number(document.querySelector('#readout-time').dataset.value) > 1.5")
-    after = pixels(page, "#overlay")
-    orange = (np.abs(after - [0xFF, 0x7F, 0x0E]) <= 40).all(axis=2)
-    rows, columns = np.nonzero(orange & (after != before).any(axis=2))
     x, y = on_screen(page, 5.0, 0.0)
-    offset = columns + box["x"] - x
+    # The overlay is drawn in animation frames after the readout changes; a busy machine delays
+    # them, so the picture is taken again until the path has reached 4.5 m (at most 10 s).
+    for _ in range(100):
+        after = pixels(page, "#overlay")
+        orange = (np.abs(after - [0xFF, 0x7F, 0x0E]) <= 40).all(axis=2)
+        rows, columns = np.nonzero(orange & (after != before).any(axis=2))
+        offset = columns + box["x"] - x
+        path = rows[np.abs(offset) <= 2] + box["y"]
+        if path.size and path.min() <= y - 4.5 / pixel:
+            break
+        page.wait_for_timeout(100)
     # Everything drawn is the path straight up from (5, 0) m and the ring around the disk...
     assert np.all(np.abs(offset) <= (1.0 + 0.2) / pixel)
     # ...and the path is a vertical line from where the disk started to past 1.5 s x 3 m/s.
-    path = rows[np.abs(offset) <= 2] + box["y"]
     assert path.max() >= y - 2 and path.min() <= y - 4.5 / pixel
 
 
