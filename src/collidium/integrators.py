@@ -197,6 +197,7 @@ class AdaptiveLeapfrog(Integrator):
         super().__init__(tolerance)
         #: Regular substeps the next interval starts with (it may take more).
         self.substeps = 1
+        self._flight: _SmoothFlight | None = None
 
     def state(self) -> dict[str, np.ndarray]:
         """The substep count the next interval starts with."""
@@ -225,7 +226,7 @@ class AdaptiveLeapfrog(Integrator):
         tally: Tally,
     ) -> None:
         start = _Snapshot(particles, tally)
-        flight = _SmoothFlight.of(particles, vessel, field)
+        flight = self._flight_for(particles, vessel, field)
         rate2 = (
             _squared_rate(particles, vessel, field)
             if flight is None
@@ -253,6 +254,14 @@ class AdaptiveLeapfrog(Integrator):
             field.evaluate(particles, vessel)
             n = max(required, 2 * n)
         self.substeps = max(1, n // 2) if required <= n // 2 else n
+
+    def _flight_for(
+        self, particles: Particles, vessel: Vessel, field: ForceField
+    ) -> _SmoothFlight | None:
+        """The scene's part in the compiled substeps (`_SmoothFlight`), kept while it fits."""
+        if self._flight is None or not self._flight.fits(particles, vessel, field):
+            self._flight = _SmoothFlight.of(particles, vessel, field)
+        return self._flight
 
     def _interval(
         self,
@@ -433,14 +442,22 @@ def _newton(
     return s if math.isfinite(s) else math.nan
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class _SmoothFlight:
-    """A scene's part in the compiled contact-free substeps (`collidium.kernels.substeps`):
-    masses, radii, the pair forces' terms and the vessel as the exact engine has it."""
+    """A scene's part in the compiled contact-free substeps (`collidium.kernels.substeps`): the
+    vessel and forces it was made for, copies of the masses, radii and the pair forces' sources
+    (the particles' properties ``names``), their couplings and squared softenings, and the walls
+    as the exact engine has them. The integrator keeps it while it `fits`: making it is most of
+    the Python work of a small scene's reporting interval."""
 
+    vessel: Vessel
+    field: ForceField
+    names: tuple[str, ...]
     mass: FloatArray
     radius: FloatArray
-    terms: tuple[FloatArray, FloatArray, FloatArray]
+    sources: FloatArray
+    couplings: FloatArray
+    softening2: FloatArray
     walls: tuple[int, float, float, float, FloatArray]
 
     @classmethod
@@ -454,15 +471,27 @@ class _SmoothFlight:
         terms = field.direct_terms(particles, vessel)
         if terms is None:
             return None
+        names, couplings, softening2 = terms
         half_width, half_height = (0.5 * float(side) for side in vessel.extent)
         walls = (vessel.shape_code, half_width, half_height, vessel.rim, vessel.segments())
-        # Contiguous copies: a shared mass or radius is a stride-0 view, which would compile the
-        # substeps a second time.
-        return cls(
-            np.ascontiguousarray(particles.mass),
-            np.ascontiguousarray(particles.radius),
-            terms,
-            walls,
+        # Contiguous copies: the particles' arrays may be edited in place (`fits` compares), and
+        # a shared mass or radius is a stride-0 view, which would compile the substeps again.
+        sources = np.stack([getattr(particles, name) for name in names])
+        return cls(vessel, field, names, np.array(particles.mass), np.array(particles.radius),
+                   sources, couplings, softening2, walls)  # fmt: skip
+
+    def fits(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
+        """Whether this is still the scene's part: the same vessel and forces, and particles of
+        the same masses, radii and sources."""
+        return (
+            vessel is self.vessel
+            and field is self.field
+            and np.array_equal(particles.mass, self.mass)
+            and np.array_equal(particles.radius, self.radius)
+            and all(
+                np.array_equal(getattr(particles, name), row)
+                for name, row in zip(self.names, self.sources, strict=True)
+            )
         )
 
     def squared_rate(self, particles: Particles, field: ForceField) -> float:
@@ -487,7 +516,8 @@ class _SmoothFlight:
         are evaluated again when read."""
         return substeps.smooth_substeps(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
-            *self.terms, *self.walls, now, dt, first, count, t, fastest, TOTAL_ENERGY_FLOOR,
+            self.sources, self.couplings, self.softening2, *self.walls, now, dt, first, count, t,
+            fastest, TOTAL_ENERGY_FLOOR,
         )  # fmt: skip
 
 

@@ -97,11 +97,10 @@ class DirectPairForce(PositionForce, Protocol):
     """A position force that may be an inverse-distance pair sum the compiled substeps can do
     (`collidium.kernels.substeps`)."""
 
-    def direct_term(
-        self, particles: Particles, vessel: Vessel
-    ) -> tuple[FloatArray, float, float] | None:
-        """``(sources (N,), coupling, squared softening in m^2)`` when the force is exactly the
-        direct inverse-distance sum of `collidium.kernels.pairwise` here, else None."""
+    def direct_term(self, particles: Particles, vessel: Vessel) -> tuple[str, float, float] | None:
+        """``(the particles' property that holds the sources, coupling, squared softening in
+        m^2)`` when the force is exactly the direct inverse-distance sum of
+        `collidium.kernels.pairwise` here, else None."""
 
 
 #: Every force by its name (filled as the force modules are imported).
@@ -314,10 +313,11 @@ class ForceField:
 
     def direct_terms(
         self, particles: Particles, vessel: Vessel
-    ) -> tuple[FloatArray, FloatArray, FloatArray] | None:
-        """The forces as the compiled substeps sum them (`collidium.kernels.substeps`): sources
-        (F, N), couplings (F,) and squared softenings (F,) m^2, when every force is a direct
-        inverse-distance pair sum (`DirectPairForce.direct_term`); None otherwise."""
+    ) -> tuple[tuple[str, ...], FloatArray, FloatArray] | None:
+        """The forces as the compiled substeps sum them (`collidium.kernels.substeps`): the
+        particles' properties that hold their sources (F names), couplings (F,) and squared
+        softenings (F,) m^2, when every force is a direct inverse-distance pair sum
+        (`DirectPairForce.direct_term`); None otherwise."""
         if self._velocity or not self._position or not self._direct:
             return None
         terms = []
@@ -327,7 +327,7 @@ class ForceField:
                 return None
             terms.append(term)
         sources, couplings, softening2 = zip(*terms, strict=True)
-        return np.stack(sources), np.array(couplings), np.array(softening2)
+        return sources, np.array(couplings), np.array(softening2)
 
     def stiffness(self, particles: Particles, vessel: Vessel) -> float:
         """``S`` of all forces at the current state, in J^2/s^4: the largest of the forces'

@@ -84,9 +84,7 @@ class Coulomb(InverseDistanceForce):
             pull = np.hypot(force[:, 0], force[:, 1]) / particles.mass
             force /= np.sqrt(1.0 + (pull / self.max_acceleration) ** 2)[:, None]
 
-    def direct_term(
-        self, particles: Particles, vessel: Vessel
-    ) -> tuple[FloatArray, float, float] | None:
+    def direct_term(self, particles: Particles, vessel: Vessel) -> tuple[str, float, float] | None:
         """The direct sum's terms (`InverseDistanceForce.direct_term`), none with a limiter."""
         if self.max_acceleration is not None:
             return None

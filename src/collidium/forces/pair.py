@@ -177,14 +177,12 @@ class InverseDistanceForce:
             particles, vessel, acceleration,
         )  # fmt: skip
 
-    def direct_term(
-        self, particles: Particles, vessel: Vessel
-    ) -> tuple[FloatArray, float, float] | None:
-        """Sources, coupling and squared softening when the sum is direct and not periodic
-        (`collidium.forces.base.DirectPairForce`)."""
+    def direct_term(self, particles: Particles, vessel: Vessel) -> tuple[str, float, float] | None:
+        """The sources' property, coupling and squared softening when the sum is direct and
+        not periodic (`collidium.forces.base.DirectPairForce`)."""
         if vessel.periodic or uses_tree(self.method, particles, vessel):
             return None
-        return getattr(particles, self.source), self.coupling, self.softening**2
+        return self.source, self.coupling, self.softening**2
 
     def summation(self) -> dict[str, object]:
         """The summation settings as in a scenario file, those at their defaults left out."""
