@@ -39,8 +39,13 @@ def test_fold_equals_bounce_by_bounce(x, v, r):
     lo, hi = -1.0 + r, 1.0 - r
     got = fold(x, v, lo, hi)
     want = reference.fold(x, v, lo, hi)
-    assert got[1] == want[1] and got[2] == want[2]
-    assert abs(got[0] - want[0]) <= 1e-12 * (1 + abs(x))
+    round_off = 1e-12 * (1 + abs(x))
+    if got[2] == want[2]:
+        assert got[1] == want[1]
+    else:  # the path ends on a wall to round-off: one bounce more or less, the last of length 0
+        assert abs(got[2] - want[2]) == 1 and got[1] == -want[1]
+        assert min(got[0] - lo, hi - got[0]) <= round_off
+    assert abs(got[0] - want[0]) <= round_off
     assert lo <= got[0] <= hi
 
 
