@@ -97,9 +97,8 @@ def smooth_substeps(
     if fastest < 0.0:
         potential = _accelerations(position, mass, index, charged, counts, couplings, softening2,
                                    moving, force, energy, virial, pull)  # fmt: skip
-        stiffness = _stiffness(position, velocity, index, charged, inverse_mass, counts,
-                               couplings, softening2, moving)  # fmt: skip
-        fastest = _squared_rate(mass, velocity, potential, stiffness, energy_floor)
+        fastest = _squared_rate(position, velocity, mass, index, charged, inverse_mass, counts,
+                                couplings, softening2, moving, potential, energy_floor)  # fmt: skip
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
@@ -123,9 +122,8 @@ def smooth_substeps(
                 velocity[i, d] = kicked[i, d] + (0.5 * h) * pull[i, d]
                 acceleration[i, d] = pull[i, d]
         t = end
-        stiffness = _stiffness(position, velocity, index, charged, inverse_mass, counts,
-                               couplings, softening2, moving)  # fmt: skip
-        rate2 = _squared_rate(mass, velocity, potential, stiffness, energy_floor)
+        rate2 = _squared_rate(position, velocity, mass, index, charged, inverse_mass, counts,
+                              couplings, softening2, moving, potential, energy_floor)  # fmt: skip
         if rate2 > fastest:
             fastest = rate2
     return count + 1, t, fastest
@@ -212,9 +210,12 @@ def _stiffness(position, velocity, index, charged, inverse_mass, counts, couplin
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _squared_rate(mass, velocity, potential, stiffness, floor) -> float:
-    """`collidium.integrators._squared_rate` of pair forces alone, 1/s^2, from the potential
-    energy (J) and the stiffness (J^2/s^4)."""
+def _squared_rate(position, velocity, mass, index, charged, inverse_mass, counts, couplings,
+                  softening2, work, potential, floor) -> float:  # fmt: skip
+    """`collidium.integrators._squared_rate` of pair forces alone, 1/s^2, given the potential
+    energy (J) of the positions: the stiffness (`_stiffness`) over the energy scale."""
+    stiffness = _stiffness(position, velocity, index, charged, inverse_mass, counts, couplings,
+                           softening2, work)  # fmt: skip
     kinetic = kinetic_energy(mass, velocity)
     scale = max(abs(kinetic + potential), (kinetic + abs(potential)) / floor)
     return math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
