@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 import pytest
@@ -165,3 +167,17 @@ def test_stiffness_of_a_pair_is_its_energy_times_its_squared_rate():
         inverse_distance_stiffness(position, velocity, charge, mass, 5.0, 0.0, 0.0, 0.0, False)
         == 0.0
     )
+
+
+@pytest.mark.parametrize("bad", [math.inf, math.nan])
+@pytest.mark.parametrize("rows", [pairwise.stiffness_serial, pairwise.stiffness_parallel])
+def test_a_non_finite_pair_stiffness_is_the_largest(rng, bad, rows):
+    """The rows take their maximum over bit patterns: an infinite or NaN velocity of the last
+    particle, met in every row's last pair, still gives an infinite or NaN stiffness."""
+    n = 40
+    position = rng.uniform(-8, 8, (n, 2))
+    velocity = rng.normal(0.0, 3.0, (n, 2))
+    velocity[-1, 0] = bad
+    charge, mass = rng.choice([-1.0, 2.0], n), np.ones(n)
+    got = rows(position, velocity, charge, mass, 5.0, 0.01, 0.0, 0.0, False)
+    assert got == bad or (math.isnan(bad) and math.isnan(got))

@@ -68,6 +68,32 @@ def test_substeps_equal_their_twin(rng, vessel, speed):
         np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-12)
 
 
+def test_a_crowd_stops_where_its_all_pairs_twin_stops(rng):
+    """49 neutral disks of radii 0.05 to 0.3 m on a jittered grid, in random motion, the pair
+    test pruned along x (disks pass each other in x from substep to substep, re-sorting the
+    sweep): in each of 40 crowds the substeps stop where the twin's test of every pair stops
+    them, at a pair (the walls are 20 m away)."""
+    grid = 1.1 * np.stack(np.meshgrid(np.arange(7), np.arange(7)), axis=-1).reshape(-1, 2) - 3.3
+    steps = []
+    for _ in range(40):
+        n = grid.shape[0]
+        position = grid + rng.uniform(-0.2, 0.2, grid.shape)  # gaps of 0.1 m at least
+        radius = rng.uniform(0.05, 0.3, n)
+        velocity = rng.normal(0.0, 1.0, (n, 2))
+        args = (np.zeros((n, 2)), np.ones(n), radius, np.zeros((1, n)), np.array([5.0]),
+                np.zeros(1), BOX)  # fmt: skip
+        got, want = (position.copy(), velocity.copy()), (position.copy(), velocity.copy())
+        step, t, _ = smooth_substeps(*got, *args, 20.0, 20.0, np.nan, NONE, 0.0, 2.0, 1, 64, 0.0,
+                                     0.0, FLOOR)  # fmt: skip
+        twin = reference.smooth_substeps(*want, *args, np.array([20.0, 20.0]), np.nan, NONE, 0.0,
+                                         2.0, 1, 64, 0.0, 0.0, FLOOR, CONTACT_MARGIN)  # fmt: skip
+        assert (step, t) == twin[:2]
+        np.testing.assert_allclose(got[0], want[0], rtol=1e-12, atol=1e-12)
+        steps.append(step)
+    assert max(steps) <= 64  # every crowd met a pair within 2 s
+    assert np.median(steps) >= 3  # most after some substeps of sweeping
+
+
 def test_a_disk_bound_for_a_wall_stops_the_substeps_just_before_it():
     """A neutral disk at 10 m/s, 1 m from a wall: substeps of 0.01 s take it to 0.1 m short
     and stop before the one that would reach it; nothing of that substep is kept."""
