@@ -68,8 +68,9 @@ def test_potential_of_two_charges_is_k_q1_q2_over_r():
     assert virial.sum() == pytest.approx(-5.0 / 4.0, rel=1e-15)
 
 
-# A quarter neutral: 2 * PARALLEL_DIRECT_FROM particles sum their rows in parallel.
-@pytest.mark.parametrize("n", [40, 2 * PARALLEL_DIRECT_FROM])
+# A quarter neutral: about 30, 128 (two or three blocks: an odd count has a middle row), 384
+# (in parallel) and 1125 charges (blocks of more than 64).
+@pytest.mark.parametrize("n", [40, 170, 2 * PARALLEL_DIRECT_FROM, 1500])
 @pytest.mark.parametrize("periodic", [False, True])
 def test_kernel_equals_numpy_twin(rng, n, periodic):
     position = rng.uniform(-8, 8, (n, 2))
@@ -84,7 +85,8 @@ def test_kernel_equals_numpy_twin(rng, n, periodic):
 
 @pytest.mark.parametrize("periodic", [False, True])
 def test_results_do_not_depend_on_the_number_of_threads(rng, periodic):
-    """Each row is summed by one thread, the same way: bit for bit the same with 1 or 2."""
+    """Each task sums into its own buffer and the buffers are added up in task order: bit for
+    bit the same with 1 or 2 threads."""
     if numba.config.NUMBA_NUM_THREADS < 2:
         pytest.skip("needs two threads")
     n = 1500
@@ -105,7 +107,7 @@ def test_results_do_not_depend_on_the_number_of_threads(rng, periodic):
 
 @pytest.mark.parametrize("periodic", [False, True])
 def test_rows_in_serial_and_in_parallel_are_bitwise_the_same(rng, periodic):
-    """Small scenes sum their rows on one thread (`PARALLEL_DIRECT_FROM`): that changes no bit."""
+    """Small scenes sum on one thread (`PARALLEL_DIRECT_FROM`): that changes no bit."""
     n = 300
     position = rng.uniform(-50, 50, (n, 2))
     velocity = rng.normal(0.0, 3.0, (n, 2))

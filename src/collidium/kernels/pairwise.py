@@ -5,12 +5,14 @@ sqrt(r^2 + eps^2)``, with a per-particle source strength ``s`` and a coupling ``
 charges with ``c = k``, Newton's gravity the masses with ``c = -G``. The loop is written once and
 takes the source and the coupling (`inverse_distance_pair` is the evaluator).
 
-Each row i is summed by one thread, always in the same way, so results do not depend on the
-number of threads (bitwise reproducible). The row loops are vectorised: ``fastmath`` lets LLVM
-reassociate (partial sums in vector lanes, ``k q_i`` taken out of the loop) and fuse
-multiply-adds. That changes the round-off of a row (not its reproducibility): ``F_ij = -F_ji``
-holds to round-off, not bit for bit. Nothing else is relaxed (no approximate functions, no
-assumptions about infinities or NaN).
+Each pair is evaluated once and its force added to both particles (``F_ji = -F_ij`` bit for
+bit). The particles are cut into at most `MOST_BLOCKS` blocks, and the tiles of two blocks
+into tasks of equal work; each task sums into a buffer of its own, and the buffers are added up
+in task order, so every particle's sums come out the same whatever the number of threads
+(bitwise reproducible), in one parallel loop. The pair loops are vectorised: ``fastmath`` lets
+LLVM reassociate (partial sums in vector lanes, ``k q_i`` taken out of the loop) and fuse
+multiply-adds, which changes the round-off of a sum, not its reproducibility. Nothing else is
+relaxed (no approximate functions, no assumptions about infinities or NaN).
 """
 
 from __future__ import annotations
@@ -55,78 +57,6 @@ def inverse_distance_pair(r2: float, kqq: float, softening2: float) -> tuple[flo
     return f, f * s2
 
 
-@numba.njit(cache=True, inline="always")
-def _window(x, y, q, lo, hi):
-    """The slices ``lo:hi`` of the arrays (views, no copy). A loop over ``range(lo, hi)`` would
-    index with a possibly negative ``j``, which numba wraps around: LLVM then vectorises the
-    loads as gathers, four times slower than a loop from 0 over views."""
-    return x[lo:hi], y[lo:hi], q[lo:hi]
-
-
-@numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def _row(
-    lo: int,
-    hi: int,
-    xi: float,
-    yi: float,
-    kqi: float,
-    x: np.ndarray,
-    y: np.ndarray,
-    q: np.ndarray,
-    softening2: float,
-) -> tuple[float, float, float, float]:
-    """Sums over ``j`` in ``lo:hi`` of the force on i (x, y), the pair energy and ``r . F``."""
-    x, y, q = _window(x, y, q, lo, hi)
-    fx = 0.0
-    fy = 0.0
-    u = 0.0
-    w = 0.0
-    for j in range(x.shape[0]):
-        dx = xi - x[j]
-        dy = yi - y[j]
-        r2 = dx * dx + dy * dy
-        f, uij = inverse_distance_pair(r2, kqi * q[j], softening2)
-        fx += f * dx
-        fy += f * dy
-        u += uij
-        w += f * r2
-    return fx, fy, u, w
-
-
-@numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def _row_periodic(
-    lo: int,
-    hi: int,
-    xi: float,
-    yi: float,
-    kqi: float,
-    x: np.ndarray,
-    y: np.ndarray,
-    q: np.ndarray,
-    softening2: float,
-    width: float,
-    height: float,
-) -> tuple[float, float, float, float]:
-    """`_row` with the minimum image."""
-    x, y, q = _window(x, y, q, lo, hi)
-    fx = 0.0
-    fy = 0.0
-    u = 0.0
-    w = 0.0
-    for j in range(x.shape[0]):
-        dx = xi - x[j]
-        dy = yi - y[j]
-        dx -= width * round(dx / width)
-        dy -= height * round(dy / height)
-        r2 = dx * dx + dy * dy
-        f, uij = inverse_distance_pair(r2, kqi * q[j], softening2)
-        fx += f * dx
-        fy += f * dy
-        u += uij
-        w += f * r2
-    return fx, fy, u, w
-
-
 def inverse_distance_direct(
     position: np.ndarray,
     source: np.ndarray,
@@ -139,13 +69,12 @@ def inverse_distance_direct(
     energy: np.ndarray,
     virial: np.ndarray,
 ) -> None:
-    """Inverse-distance forces and per-particle energies by direct summation, O(N^2), parallel
-    over rows from `PARALLEL_DIRECT_FROM` particles on, on the calling thread below:
-    ``F_i = c s_i sum_j s_j r_ij / (r^2 + eps^2)^(3/2)``.
+    """Inverse-distance forces and per-particle energies by direct summation, O(N^2), each pair
+    once (`pair_sums`), in parallel from `PARALLEL_DIRECT_FROM` particles on, on the calling
+    thread below: ``F_i = c s_i sum_j s_j r_ij / (r^2 + eps^2)^(3/2)``.
 
     Only particles with a source enter the sums (a neutral one feels and exerts no Coulomb
-    force), read from contiguous copies of their coordinates and sources. Each row is summed
-    over ``j < i`` then ``j > i``, with no branch in the loops, which LLVM vectorises.
+    force), read from contiguous copies of their coordinates and sources.
 
     Parameters
     ----------
@@ -172,12 +101,12 @@ def inverse_distance_direct(
     rows(position, source, coupling, softening2, width, height, periodic, force, energy, virial)
 
 
-#: Particles from which `inverse_distance_direct` and `inverse_distance_stiffness` run their rows
-#: in parallel: below, waking the second thread costs more than the rows bring, and far more when
-#: another program keeps it busy (`benchmarks/bench_threads.py`). A row is summed alike either
-#: way, so the results are bitwise the same. The choice is made here, in Python: a compiled
-#: kernel calling a parallel one breaks numba's cache (the caller, once cached against a callee
-#: itself loaded from the cache, crashes the next process that loads it).
+#: Particles from which `inverse_distance_direct` and `inverse_distance_stiffness` run in
+#: parallel: below, waking the second thread costs more than it brings, and far more when
+#: another program keeps it busy (`benchmarks/bench_threads.py`). The sums are taken in the same
+#: order either way, so the results are bitwise the same. The choice is made here, in Python: a
+#: compiled kernel calling a parallel one breaks numba's cache (the caller, once cached against
+#: a callee itself loaded from the cache, crashes the next process that loads it).
 PARALLEL_DIRECT_FROM = 256
 
 
@@ -205,44 +134,148 @@ def _sources(position, source, force, energy, virial):
     return x[:m], y[:m], q[:m], index[:m]
 
 
+#: Most blocks the pair sums cut the particles into (`_blocks`): the tasks, two rows of tiles
+#: each, are half as many, and each has a buffer of 4 values per particle.
+MOST_BLOCKS = 16
+
+
 @numba.njit(cache=True, inline="always")
-def direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force, energy,
-                virial) -> None:  # fmt: skip
-    """Row c of `inverse_distance_direct`: the sums over ``j < c`` then ``j > c``, written to
-    the particle ``index[c]``."""
+def _blocks(m: int) -> tuple[int, int, int]:
+    """How the pair sums cut m particles into blocks: ``(block size, blocks, tasks)``. Blocks of
+    64 particles, or of a multiple of 16 that makes at most `MOST_BLOCKS`; task t takes the
+    tiles of block rows t and ``blocks - 1 - t``, as many tiles as every other task. All of it
+    depends on m alone, never on the number of threads."""
+    size = max(64, ((m + MOST_BLOCKS - 1) // MOST_BLOCKS + 15) // 16 * 16)
+    blocks = (m + size - 1) // size
+    return size, blocks, (blocks + 1) // 2
+
+
+@numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def _tile(first, second, size, x, y, q, coupling, softening2, width, height, periodic, sums):
+    """The pairs of block ``first`` with block ``second`` (each pair of the block once when they
+    are the same), added to both particles' ``sums`` (4, m): force x, y, pair energy, ``r . F``.
+
+    Every i-row runs over views that start at 0: a loop over ``range(lo, hi)`` would index with
+    a possibly negative j, which numba wraps around, and LLVM would then gather the loads, four
+    times slower."""
     m = x.shape[0]
-    xi, yi, kqi = x[c], y[c], coupling * q[c]
-    if periodic:
-        below = _row_periodic(0, c, xi, yi, kqi, x, y, q, softening2, width, height)
-        above = _row_periodic(c + 1, m, xi, yi, kqi, x, y, q, softening2, width, height)
-    else:
-        below = _row(0, c, xi, yi, kqi, x, y, q, softening2)
-        above = _row(c + 1, m, xi, yi, kqi, x, y, q, softening2)
-    i = index[c]
-    force[i, 0] = below[0] + above[0]
-    force[i, 1] = below[1] + above[1]
-    energy[i] = 0.5 * (below[2] + above[2])
-    virial[i] = 0.5 * (below[3] + above[3])
+    for i in range(first * size, min(m, (first + 1) * size)):
+        lo, hi = max(second * size, i + 1), min(m, (second + 1) * size)
+        xi, yi, kqi = x[i], y[i], coupling * q[i]
+        xj, yj, qj = x[lo:hi], y[lo:hi], q[lo:hi]
+        fxj, fyj, uj, wj = sums[0, lo:hi], sums[1, lo:hi], sums[2, lo:hi], sums[3, lo:hi]
+        fx = 0.0
+        fy = 0.0
+        u = 0.0
+        w = 0.0
+        for j in range(xj.shape[0]):
+            dx = xi - xj[j]
+            dy = yi - yj[j]
+            if periodic:  # the same every pass: LLVM takes it out of the loop
+                dx -= width * round(dx / width)
+                dy -= height * round(dy / height)
+            r2 = dx * dx + dy * dy
+            f, uij = inverse_distance_pair(r2, kqi * qj[j], softening2)
+            fx += f * dx
+            fy += f * dy
+            u += uij
+            w += f * r2
+            fxj[j] -= f * dx
+            fyj[j] -= f * dy
+            uj[j] += uij
+            wj[j] += f * r2
+        sums[0, i] += fx
+        sums[1, i] += fy
+        sums[2, i] += u
+        sums[3, i] += w
+
+
+@numba.njit(cache=True)
+def _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums) -> None:
+    """Task t of the pair sums: the tiles of block rows t and ``blocks - 1 - t`` (each tile of a
+    row with itself and the blocks after it) into its own ``sums`` (4, m), zeroed first."""
+    sums[:, :] = 0.0
+    mirror = blocks - 1 - t
+    for first in range(t, mirror + 1, max(1, mirror - t)):  # rows t and mirror (once if one)
+        for second in range(first, blocks):
+            _tile(first, second, size, x, y, q, coupling, softening2, width, height, periodic,
+                  sums)  # fmt: skip
+
+
+@numba.njit(cache=True, inline="always")
+def _total(buffers, sums) -> None:
+    """``sums`` (4, m): the tasks' ``buffers`` (tasks, 4, m) added up in task order."""
+    sums[:, :] = 0.0
+    for t in range(buffers.shape[0]):
+        sums += buffers[t]
+
+
+@numba.njit(cache=True)
+def pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buffer) -> None:
+    """Every pair's force x, y, energy and ``r . F`` on both particles into ``sums`` (4, m),
+    each pair once, on the calling thread: task by task, each in a buffer of its own, the
+    buffers then added up in task order, as `direct_parallel` does on all threads, so both give
+    the same bits.
+
+    Parameters
+    ----------
+    x, y, q : ndarray, shape (m,)
+        Contiguous coordinates (m) and sources of the particles with a source.
+    coupling, softening2, width, height, periodic
+        As in `inverse_distance_direct`.
+    sums : ndarray, shape (4, m)
+        Output: force x and y (N), the sum of the pair energies (J) and of ``r_ij . F_ij``.
+    buffer : ndarray, shape (4 * m * tasks,) at least
+        Work space for the tasks (`_blocks`: at most ``MOST_BLOCKS / 2``).
+    """
+    m = x.shape[0]
+    size, blocks, tasks = _blocks(m)
+    buffers = buffer[: tasks * 4 * m].reshape((tasks, 4, m))
+    for t in range(tasks):
+        _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, buffers[t])
+    _total(buffers, sums)
+
+
+@numba.njit(cache=True, inline="always")
+def _scatter(sums, index, force, energy, virial) -> None:
+    """The sums of the particles with a source to their places (halves of the pair energies
+    and virials: each pair's is shared by its two particles)."""
+    for c in range(index.shape[0]):
+        i = index[c]
+        force[i, 0] = sums[0, c]
+        force[i, 1] = sums[1, c]
+        energy[i] = 0.5 * sums[2, c]
+        virial[i] = 0.5 * sums[3, c]
 
 
 @numba.njit(cache=True, parallel=True)
 def direct_parallel(position, source, coupling, softening2, width, height, periodic, force,
                     energy, virial) -> None:  # fmt: skip
-    """`inverse_distance_direct`'s rows in parallel."""
+    """`inverse_distance_direct` on all threads: `pair_sums`'s tasks side by side, in one
+    parallel loop (each wakes every thread, which costs milliseconds on a busy machine). The
+    loop is written out here: a compiled kernel calling a parallel one breaks numba's cache
+    (`PARALLEL_DIRECT_FROM`)."""
     x, y, q, index = _sources(position, source, force, energy, virial)
-    for c in numba.prange(x.shape[0]):
-        direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force,
-                    energy, virial)  # fmt: skip
+    m = x.shape[0]
+    size, blocks, tasks = _blocks(m)
+    buffers = np.empty((tasks, 4, m))
+    for t in numba.prange(tasks):
+        _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, buffers[t])
+    sums = np.empty((4, m))
+    _total(buffers, sums)
+    _scatter(sums, index, force, energy, virial)
 
 
 @numba.njit(cache=True)
 def direct_serial(position, source, coupling, softening2, width, height, periodic, force,
                   energy, virial) -> None:  # fmt: skip
-    """`inverse_distance_direct`'s rows on the calling thread."""
+    """`inverse_distance_direct` on the calling thread (`pair_sums`)."""
     x, y, q, index = _sources(position, source, force, energy, virial)
-    for c in range(x.shape[0]):
-        direct_row(c, x, y, q, index, coupling, softening2, width, height, periodic, force,
-                    energy, virial)  # fmt: skip
+    m = x.shape[0]
+    sums = np.empty((4, m))
+    buffer = np.empty(4 * m * _blocks(m)[2])
+    pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buffer)
+    _scatter(sums, index, force, energy, virial)
 
 
 @numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
@@ -264,7 +297,7 @@ def stiffness_row(
     (`inverse_distance_stiffness`)."""
     xc, yc, vxc, vyc = x[c], y[c], vx[c], vy[c]
     kqc, mc = abs(coupling * q[c]), inverse_mass[c]
-    # Views from 0 (see `_window`).
+    # Views from 0 (see `_tile`).
     x, y, vx, vy = x[c + 1 :], y[c + 1 :], vx[c + 1 :], vy[c + 1 :]
     q, inverse_mass = q[c + 1 :], inverse_mass[c + 1 :]
     # The maximum of non-negative floats as that of their bit patterns, which order alike: LLVM

@@ -19,7 +19,7 @@ import math
 import numba
 import numpy as np
 
-from collidium.kernels.pairwise import direct_row, larger, stiffness_row
+from collidium.kernels.pairwise import MOST_BLOCKS, larger, pair_sums, stiffness_row
 from collidium.kernels.vessels import contacts
 
 #: Relative margin of the contact test: a disk that comes within this fraction of its radius (or
@@ -87,17 +87,15 @@ def smooth_substeps(
     kicked = np.empty((n, 2))
     flown = np.empty((n, 2))
     pull = np.empty((n, 2))
-    force = np.empty((n, 2))
-    energy = np.empty(n)
-    virial = np.empty(n)
     # Each force's particles with a source, in a row of (index, source, 1 / mass), and work
     # rows for their coordinates and velocities: the pair rows read contiguous arrays.
     index, charged, inverse_mass, counts = _with_sources(sources, mass)
     moving = np.empty((4, n))
+    sums = np.empty(4 * n * (1 + MOST_BLOCKS // 2))  # the pair sums' work (`_accelerations`)
     order, span = np.arange(n), np.empty((2, n))  # the contact test's sweep (`_meets_contact`)
     if fastest < 0.0:
         potential = _accelerations(position, mass, index, charged, counts, couplings, softening2,
-                                   moving, force, energy, virial, pull)  # fmt: skip
+                                   moving, sums, pull)  # fmt: skip
         fastest = _squared_rate(position, velocity, mass, index, charged, inverse_mass, counts,
                                 couplings, softening2, moving, potential, energy_floor)  # fmt: skip
     for s in range(first, count + 1):
@@ -113,7 +111,7 @@ def smooth_substeps(
             for d in range(2):
                 flown[i, d] = position[i, d] + kicked[i, d] * h
         potential = _accelerations(flown, mass, index, charged, counts, couplings, softening2,
-                                   moving, force, energy, virial, pull)  # fmt: skip
+                                   moving, sums, pull)  # fmt: skip
         if not _finite(pull):
             return s, t, fastest
         for i in range(n):
@@ -159,11 +157,12 @@ def _with_sources(sources, mass):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _accelerations(position, mass, index, charged, counts, couplings, softening2, work, force,
-                   energy, virial, out):  # fmt: skip
+def _accelerations(position, mass, index, charged, counts, couplings, softening2, work, buffer,
+                   out):  # fmt: skip
     """The accelerations (N, 2) of the pair forces into ``out`` (the sum of the forces over the
-    masses, as `collidium.forces.base.ForceField.evaluate` forms them), by the rows of
-    `collidium.kernels.pairwise.inverse_distance_direct`; returns the potential energy, J."""
+    masses, as `collidium.forces.base.ForceField.evaluate` forms them), by the pair sums of
+    `collidium.kernels.pairwise.inverse_distance_direct` in ``buffer`` (4 N (1 + MOST_BLOCKS / 2));
+    returns the potential energy, J."""
     n = position.shape[0]
     out[:, :] = 0.0
     potential = 0.0
@@ -173,16 +172,14 @@ def _accelerations(position, mass, index, charged, counts, couplings, softening2
         for c in range(m):
             x[c] = position[index[f, c], 0]
             y[c] = position[index[f, c], 1]
-        force[:, :] = 0.0
-        energy[:] = 0.0
-        virial[:] = 0.0
+        sums = buffer[: 4 * m].reshape((4, m))  # contiguous, as `pair_sums` is compiled for
+        pair_sums(x, y, charged[f, :m], couplings[f], softening2[f], 0.0, 0.0, False, sums,
+                  buffer[4 * m :])  # fmt: skip
         for c in range(m):
-            direct_row(c, x, y, charged[f, :m], index[f, :m], couplings[f], softening2[f], 0.0,
-                        0.0, False, force, energy, virial)  # fmt: skip
-        for i in range(n):
-            out[i, 0] += force[i, 0]
-            out[i, 1] += force[i, 1]
-            potential += energy[i]
+            i = index[f, c]
+            out[i, 0] += sums[0, c]
+            out[i, 1] += sums[1, c]
+            potential += 0.5 * sums[2, c]
     for i in range(n):
         out[i, 0] /= mass[i]
         out[i, 1] /= mass[i]
