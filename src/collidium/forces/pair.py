@@ -22,10 +22,11 @@ from collidium.vessels import Vessel
 SumMethod = Literal["auto", "direct", "tree"]
 SUM_METHODS: tuple[SumMethod, ...] = ("auto", "direct", "tree")
 
-#: Particles with a source from which ``method="auto"`` sums by tree. On 2 threads the two cost
-#: the same near N = 200 (0.10 against 0.11 us per particle) and the tree is 1.5x faster at 500;
-#: from 500 on, so that the small seed scenes keep the exact direct sum.
-TREE_CROSSOVER = 500
+#: Particles with a source from which ``method="auto"`` sums by tree. On 2 threads the direct
+#: sum takes 0.8-1.3 times the tree's time at N = 500 and 1000, 1.6-2.0 times at 2000 and 4 times
+#: at 8000 (`benchmarks/bench_core.py`, W2's costs): from 1000 on, so that up to there every
+#: scene keeps the exact direct sum.
+TREE_CROSSOVER = 1000
 
 #: The tree's default opening angle.
 DEFAULT_THETA = tree.THETA

@@ -31,6 +31,9 @@ from numba.extending import intrinsic
 #: without which a zero-division check in the loop would keep it from being vectorised.
 _FASTMATH = {"reassoc", "contract"}
 
+#: Loop counters of this type index without numba's wraparound of negative indices.
+_u: Any = numba.uint64  # a cast the type checker cannot follow
+
 
 @numba.njit(cache=True, inline="always")
 def inverse_distance_pair(r2: float, kqq: float, softening2: float) -> tuple[float, float]:
@@ -155,35 +158,32 @@ def _tile(first, second, size, x, y, q, coupling, softening2, width, height, per
     """The pairs of block ``first`` with block ``second`` (each pair of the block once when they
     are the same), added to both particles' ``sums`` (4, m): force x, y, pair energy, ``r . F``.
 
-    Every i-row runs over views that start at 0: a loop over ``range(lo, hi)`` would index with
-    a possibly negative j, which numba wraps around, and LLVM would then gather the loads, four
-    times slower."""
+    The pair loops count with unsigned integers: a signed j could be negative, which numba
+    wraps around, and LLVM would then gather the loads, four times slower."""
     m = x.shape[0]
     for i in range(first * size, min(m, (first + 1) * size)):
         lo, hi = max(second * size, i + 1), min(m, (second + 1) * size)
         xi, yi, kqi = x[i], y[i], coupling * q[i]
-        xj, yj, qj = x[lo:hi], y[lo:hi], q[lo:hi]
-        fxj, fyj, uj, wj = sums[0, lo:hi], sums[1, lo:hi], sums[2, lo:hi], sums[3, lo:hi]
         fx = 0.0
         fy = 0.0
         u = 0.0
         w = 0.0
-        for j in range(xj.shape[0]):
-            dx = xi - xj[j]
-            dy = yi - yj[j]
+        for j in range(_u(lo), _u(hi)):
+            dx = xi - x[j]
+            dy = yi - y[j]
             if periodic:  # the same every pass: LLVM takes it out of the loop
                 dx -= width * round(dx / width)
                 dy -= height * round(dy / height)
             r2 = dx * dx + dy * dy
-            f, uij = inverse_distance_pair(r2, kqi * qj[j], softening2)
+            f, uij = inverse_distance_pair(r2, kqi * q[j], softening2)
             fx += f * dx
             fy += f * dy
             u += uij
             w += f * r2
-            fxj[j] -= f * dx
-            fyj[j] -= f * dy
-            uj[j] += uij
-            wj[j] += f * r2
+            sums[0, j] -= f * dx
+            sums[1, j] -= f * dy
+            sums[2, j] += uij
+            sums[3, j] += f * r2
         sums[0, i] += fx
         sums[1, i] += fy
         sums[2, i] += u
@@ -194,7 +194,7 @@ def _tile(first, second, size, x, y, q, coupling, softening2, width, height, per
 def _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums) -> None:
     """Task t of the pair sums: the tiles of block rows t and ``blocks - 1 - t`` (each tile of a
     row with itself and the blocks after it) into its own ``sums`` (4, m), zeroed first."""
-    sums[:, :] = 0.0
+    _zero(sums)
     mirror = blocks - 1 - t
     for first in range(t, mirror + 1, max(1, mirror - t)):  # rows t and mirror (once if one)
         for second in range(first, blocks):
@@ -205,9 +205,20 @@ def _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodi
 @numba.njit(cache=True, inline="always")
 def _total(buffers, sums) -> None:
     """``sums`` (4, m): the tasks' ``buffers`` (tasks, 4, m) added up in task order."""
-    sums[:, :] = 0.0
+    _zero(sums)
     for t in range(buffers.shape[0]):
-        sums += buffers[t]
+        for d in range(4):
+            for c in range(sums.shape[1]):
+                sums[d, c] += buffers[t, d, c]
+
+
+@numba.njit(cache=True, inline="always")
+def _zero(sums) -> None:
+    """Zero ``sums`` (4, m) in a plain loop (an array expression costs a few hundred ns, which a
+    scene of three bodies pays at every substep)."""
+    for d in range(4):
+        for c in range(sums.shape[1]):
+            sums[d, c] = 0.0
 
 
 @numba.njit(cache=True)
@@ -226,10 +237,14 @@ def pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buff
     sums : ndarray, shape (4, m)
         Output: force x and y (N), the sum of the pair energies (J) and of ``r_ij . F_ij``.
     buffer : ndarray, shape (4 * m * tasks,) at least
-        Work space for the tasks (`_blocks`: at most ``MOST_BLOCKS / 2``).
+        Work space for the tasks (`_blocks`: at most ``MOST_BLOCKS / 2``); one task, up to 128
+        particles, sums into ``sums`` itself.
     """
     m = x.shape[0]
     size, blocks, tasks = _blocks(m)
+    if tasks == 1:  # as `direct_parallel` does
+        _task(0, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
+        return
     buffers = buffer[: tasks * 4 * m].reshape((tasks, 4, m))
     for t in range(tasks):
         _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, buffers[t])
@@ -258,11 +273,15 @@ def direct_parallel(position, source, coupling, softening2, width, height, perio
     x, y, q, index = _sources(position, source, force, energy, virial)
     m = x.shape[0]
     size, blocks, tasks = _blocks(m)
-    buffers = np.empty((tasks, 4, m))
-    for t in numba.prange(tasks):
-        _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, buffers[t])
     sums = np.empty((4, m))
-    _total(buffers, sums)
+    if tasks == 1:  # one task sums into ``sums`` itself, as in `pair_sums`
+        _task(0, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
+    else:
+        buffers = np.empty((tasks, 4, m))
+        for t in numba.prange(tasks):
+            _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic,
+                  buffers[t])  # fmt: skip
+        _total(buffers, sums)
     _scatter(sums, index, force, energy, virial)
 
 
@@ -297,14 +316,11 @@ def stiffness_row(
     (`inverse_distance_stiffness`)."""
     xc, yc, vxc, vyc = x[c], y[c], vx[c], vy[c]
     kqc, mc = abs(coupling * q[c]), inverse_mass[c]
-    # Views from 0 (see `_tile`).
-    x, y, vx, vy = x[c + 1 :], y[c + 1 :], vx[c + 1 :], vy[c + 1 :]
-    q, inverse_mass = q[c + 1 :], inverse_mass[c + 1 :]
     # The maximum of non-negative floats as that of their bit patterns, which order alike: LLVM
     # vectorises an integer maximum, not a float one. Without the sign bit a NaN is the largest
     # pattern, and is kept.
     largest = 0
-    for j in range(x.shape[0]):
+    for j in range(_u(c + 1), _u(x.shape[0])):  # unsigned: see `_tile`
         dx = xc - x[j]
         dy = yc - y[j]
         if periodic:  # the same every pass: LLVM takes it out of the loop
