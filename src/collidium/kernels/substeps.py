@@ -186,7 +186,7 @@ def _accelerations(position, mass, index, charged, counts, couplings, softening2
     return potential
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")  # that of the inlined rows
 def _stiffness(position, velocity, index, charged, inverse_mass, counts, couplings, softening2,
                work) -> float:  # fmt: skip
     """The largest ``(|U_ij| rate_ij^2)^2`` over the pairs of every force, J^2/s^4
@@ -254,7 +254,7 @@ def _meets_contact(position, velocity, radius, lag, shape, half_width, half_heig
     return False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")  # no call with a view (`stiffness_row`)
 def _sort_by(order, key) -> None:
     """Insertion sort of ``order`` (N,) by ``key[order]``: a few moves for a list that was sorted
     a substep ago."""
