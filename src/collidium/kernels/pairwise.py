@@ -297,7 +297,7 @@ def direct_serial(position, source, coupling, softening2, width, height, periodi
     _scatter(sums, index, force, energy, virial)
 
 
-@numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy", inline="always")
+@numba.njit(cache=True, inline="always")  # compiled with each caller's flags
 def stiffness_row(
     c: int,
     x: np.ndarray,
