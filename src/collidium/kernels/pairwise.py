@@ -292,7 +292,8 @@ def direct_serial(position, source, coupling, softening2, width, height, periodi
     x, y, q, index = _sources(position, source, force, energy, virial)
     m = x.shape[0]
     sums = np.empty((4, m))
-    buffer = np.empty(4 * m * _blocks(m)[2])
+    tasks = _blocks(m)[2]
+    buffer = np.empty(4 * m * tasks if tasks > 1 else 0)  # one task sums into ``sums``
     pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buffer)
     _scatter(sums, index, force, energy, virial)
 

@@ -1,13 +1,19 @@
-"""Stable radix sort of integer keys, shared by the tree's Morton order and the step mode's pairs.
+"""Sorts shared by the kernels.
 
-A comparison sort of random keys mispredicts a branch per comparison; an LSD radix sort makes a
-few passes of counting and scattering instead, and is stable, so equal keys keep their order.
+`radix_sort`, for the tree's Morton order and the step mode's pairs: a comparison sort of random
+keys mispredicts a branch per comparison; an LSD radix sort makes a few passes of counting and
+scattering instead, and is stable, so equal keys keep their order. `sort_nearly_sorted`, for
+lists that moved little since they were last sorted: the step mode's movers between cells, the
+compiled substeps' sweep.
 """
 
 from __future__ import annotations
 
 import numba
 import numpy as np
+
+#: Unsigned indices: no wraparound of negative ones.
+_u = numba.uint64
 
 #: Bits sorted per pass: 2048 counters fit in the L1 cache.
 DIGIT_BITS = 11
@@ -63,3 +69,24 @@ def radix_sort(
         keys[:] = keys_spare
         if carry:
             values[:] = values_spare
+
+
+@numba.njit(cache=True)
+def sort_nearly_sorted(index: np.ndarray, key: np.ndarray) -> None:
+    """Stable sort of ``index`` (M,) in place by ``key[index]``, for a list that is nearly in
+    order already: an insertion sort has little to do; past a budget of shifts a merge sort takes
+    over."""
+    m = index.shape[0]
+    budget = 64 * m + 1024
+    for t in range(1, m):
+        s = index[t]
+        c = key[_u(s)]
+        u = t
+        while u > 0 and key[_u(index[u - 1])] > c:
+            index[u] = index[u - 1]
+            u -= 1
+        index[u] = s
+        budget -= t - u
+        if budget < 0:
+            index[:] = index[np.argsort(key[index], kind="mergesort")]
+            return

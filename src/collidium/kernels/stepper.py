@@ -25,7 +25,7 @@ import numpy as np
 
 from collidium.kernels.cells import grid_shape
 from collidium.kernels.collision import energy_change, pair_response
-from collidium.kernels.sorting import radix_sort
+from collidium.kernels.sorting import radix_sort, sort_nearly_sorted
 
 #: Cast to an unsigned index. Numba wraps negative indices around; with an unsigned one it need
 #: not check, which makes the random reads of a gather about twice as fast.
@@ -363,29 +363,6 @@ def gather_movers(
 
 
 @numba.njit(cache=True)
-def _sort_movers(movers: np.ndarray, new_key: np.ndarray) -> None:
-    """Stable sort of the movers by their new cell.
-
-    They come in slot order, so by their old cell, and most moved to a neighbouring cell: an
-    insertion sort has little to do. Past a budget of shifts, a merge sort takes over.
-    """
-    m = movers.shape[0]
-    budget = 64 * m + 1024
-    for t in range(1, m):
-        s = movers[t]
-        c = new_key[_u(s)]
-        u = t
-        while u > 0 and new_key[_u(movers[u - 1])] > c:
-            movers[u] = movers[u - 1]
-            u -= 1
-        movers[u] = s
-        budget -= t - u
-        if budget < 0:
-            movers[:] = movers[np.argsort(new_key[movers], kind="mergesort")]
-            return
-
-
-@numba.njit(cache=True)
 def _range_of(cell: int, cell_at: np.ndarray, guess: int) -> int:
     """The merge range ``p`` with ``cell_at[p] <= cell < cell_at[p + 1]``, searched from
     ``guess`` (a mover's own range, which it has seldom left)."""
@@ -559,7 +536,8 @@ def update_cells(
             elif lo < slot_at[p]:
                 below[p] += np.searchsorted(movers[lo : lo + moved[q]], slot_at[p])
     for p in numba.prange(chunks):
-        _sort_movers(grouped[group_at[p] : group_at[p + 1]], new_key)
+        # By their new cell: they come by their old one, and most moved to a neighbouring cell.
+        sort_nearly_sorted(grouped[group_at[p] : group_at[p + 1]], new_key)
         out = slot_at[p] - below[p] + group_at[p]
         if uniform:  # a constant argument: numba compiles each case on its own
             _merge_range(

@@ -20,6 +20,7 @@ import numba
 import numpy as np
 
 from collidium.kernels.pairwise import MOST_BLOCKS, larger, pair_sums, stiffness_row
+from collidium.kernels.sorting import sort_nearly_sorted
 from collidium.kernels.vessels import contacts
 
 #: Relative margin of the contact test: a disk that comes within this fraction of its radius (or
@@ -92,7 +93,8 @@ def smooth_substeps(
     index, charged, inverse_mass, counts = _with_sources(sources, mass)
     moving = np.empty((4, n))
     sums = np.empty(4 * n * (1 + MOST_BLOCKS // 2))  # the pair sums' work (`_accelerations`)
-    order, span = np.arange(n), np.empty((2, n))  # the contact test's sweep (`_meets_contact`)
+    order, low, high = np.arange(n), np.empty(n), np.empty(n)  # the sweep (`_meets_contact`)
+    walls = (shape, half_width, half_height, rim, segments)
     if fastest < 0.0:
         potential = _accelerations(position, mass, index, charged, counts, couplings, softening2,
                                    moving, sums, pull)  # fmt: skip
@@ -104,8 +106,8 @@ def smooth_substeps(
         for i in range(n):
             for d in range(2):
                 kicked[i, d] = velocity[i, d] + (0.5 * h) * acceleration[i, d]
-        walls = (shape, half_width, half_height, rim, segments)
-        if not _finite(kicked) or _meets_contact(position, kicked, radius, h, *walls, order, span):
+        if not _finite(kicked) or _meets_contact(position, kicked, radius, h, *walls, order, low,
+                                                 high):  # fmt: skip
             return s, t, fastest
         for i in range(n):
             for d in range(2):
@@ -220,14 +222,14 @@ def _squared_rate(position, velocity, mass, index, charged, inverse_mass, counts
 
 @numba.njit(cache=True)
 def _meets_contact(position, velocity, radius, lag, shape, half_width, half_height, rim,
-                   segments, order, span) -> bool:  # fmt: skip
+                   segments, order, low, high) -> bool:  # fmt: skip
     """Whether a straight flight of ``lag`` seconds may bring a disk to a wall or another disk
     (within `CONTACT_MARGIN`).
 
-    Pairs are swept and pruned along x: ``span`` (2, N) gets the x-interval each disk sweeps,
-    and ``order`` (N,) lists the disks by its low end, kept from the last call (an insertion
-    sort of a nearly sorted list); a pair is tested only if their intervals overlap, which two
-    disks that meet must do."""
+    Pairs are swept and pruned along x: ``low`` and ``high`` (N,) get the x-interval each disk
+    sweeps, and ``order`` (N,) lists the disks by its low end, kept from the last call (a nearly
+    sorted list); a pair is tested only if their intervals overlap, which two disks that meet
+    must do."""
     n = position.shape[0]
     horizon = lag * (1.0 + CONTACT_MARGIN)
     for i in range(n):
@@ -239,32 +241,19 @@ def _meets_contact(position, velocity, radius, lag, shape, half_width, half_heig
     for i in range(n):
         reach = radius[i] * (1.0 + 2.0 * CONTACT_MARGIN)  # wider than the test: never prunes a hit
         x, travel = position[i, 0], velocity[i, 0] * horizon
-        span[0, i] = min(x, x + travel) - reach
-        span[1, i] = max(x, x + travel) + reach
-    _sort_by(order, span[0])
+        low[i] = min(x, x + travel) - reach
+        high[i] = max(x, x + travel) + reach
+    sort_nearly_sorted(order, low)
     for a in range(n):
         i = order[a]
         for b in range(a + 1, n):
             j = order[b]
-            if span[0, j] > span[1, i]:
+            if low[j] > high[i]:
                 break
             sigma = (radius[i] + radius[j]) * (1.0 + CONTACT_MARGIN)
             if sigma > 0.0 and _closest(position, velocity, i, j, horizon) <= sigma * sigma:
                 return True
     return False
-
-
-@numba.njit(cache=True, inline="always")  # no call with a view (`stiffness_row`)
-def _sort_by(order, key) -> None:
-    """Insertion sort of ``order`` (N,) by ``key[order]``: a few moves for a list that was sorted
-    a substep ago."""
-    for a in range(1, order.shape[0]):
-        i = order[a]
-        b = a
-        while b > 0 and key[order[b - 1]] > key[i]:
-            order[b] = order[b - 1]
-            b -= 1
-        order[b] = i
 
 
 @numba.njit(cache=True, inline="always")
