@@ -190,6 +190,41 @@ def test_results_do_not_depend_on_the_number_of_threads():
     np.testing.assert_array_equal(runs[0].particles.velocity, runs[1].particles.velocity)
 
 
+@pytest.mark.parametrize("integrator", ["fixed", "adaptive"])
+def test_reading_the_energies_changes_no_bit_of_a_run(integrator):
+    """Kicks sum the forces alone and the energies are summed when read: a run watched every
+    step, or every seventh, is bit for bit the run nobody watches, collisions included."""
+    runs = []
+    for trigger in (None, 1, 7):
+        sim = cd.load("charged-gas", n=40, integrator=integrator)
+        if trigger is not None:
+            sim.observers.append(cd.observers.EnergyDrift(trigger=trigger))
+        runs.append(sim.run(time=0.3))
+    assert runs[0].counters.pair_collisions > 0
+    for watched in runs[1:]:
+        np.testing.assert_array_equal(watched.particles.position, runs[0].particles.position)
+        np.testing.assert_array_equal(watched.particles.velocity, runs[0].particles.velocity)
+    assert runs[0].energy() == runs[1].energy()
+
+
+def test_an_unwatched_fixed_step_sums_no_energies(monkeypatch):
+    """The fixed step's kicks sum no energies unless they are read: none when nobody watches,
+    and with the forces of each step's kick (no second pass) when an observer reads every
+    step."""
+    asked: list[bool] = []
+    compute = cd.Coulomb.compute
+    monkeypatch.setattr(cd.Coulomb, "compute", lambda self, *args: asked.append(args[-1])
+                        or compute(self, *args))  # fmt: skip
+    cd.load("charged-like", integrator="fixed").run(steps=30)
+    assert len(asked) == 31 and not any(asked)  # the run's first evaluation, then one a step
+    asked.clear()
+    sim = cd.load("charged-like", integrator="fixed")
+    sim.observers.append(cd.observers.EnergyDrift())
+    sim.run(steps=30)
+    # The first sample's evaluation, the run's first (forces alone), one a step with energies.
+    assert asked == [True, False] + [True] * 30
+
+
 def test_integrator_and_tolerance_can_change_between_runs():
     sim = cd.load("orbit")
     sim.integrator = "fixed"

@@ -158,7 +158,7 @@ class Leapfrog(Integrator):
     ) -> None:
         _kick(particles, vessel, field, dt, tally)
         drift.drift(particles, vessel, now, dt, tally, field.acceleration, fall=field.fall)
-        _closing_kick(particles, vessel, field, dt, tally)
+        _closing_kick(particles, vessel, field, dt, tally, closes_step=True)
 
 
 class AdaptiveLeapfrog(Integrator):
@@ -227,10 +227,15 @@ class AdaptiveLeapfrog(Integrator):
     ) -> None:
         start = _Snapshot(particles, tally)
         flight = self._flight_for(particles, vessel, field)
+        # The energy the substeps' rate is judged against: the interval's one read of the
+        # energies (the forces keep the total within the tolerance over the interval).
+        total = substeps.kinetic_energy(particles.mass, particles.velocity) + field.potential(
+            particles, vessel
+        )
         rate2 = (
-            _squared_rate(particles, vessel, field)
+            _squared_rate(particles, vessel, field, total)
             if flight is None
-            else flight.squared_rate(particles, field)
+            else flight.squared_rate(particles, field, total)
         )
         if not dt * math.sqrt(rate2) <= MAX_SUBSTEPS * self.tolerance:  # also NaN
             raise SimulationError(
@@ -241,7 +246,7 @@ class AdaptiveLeapfrog(Integrator):
         while True:
             try:
                 fastest = self._interval(
-                    particles, vessel, field, drift, flight, now, dt, tally, n, rate2
+                    particles, vessel, field, drift, flight, now, dt, tally, n, rate2, total
                 )
             except SimulationError:  # any stop inside the interval leaves the state it began from
                 start.restore(particles, tally)
@@ -275,23 +280,26 @@ class AdaptiveLeapfrog(Integrator):
         tally: Tally,
         n: int,
         fastest: float,
+        total: float,
     ) -> float:
         """Take the interval in ``n`` regular substeps (each split at contacts), those that meet
         no contact by the compiled ``flight`` where there is one; returns the largest squared
         rate (1/s^2) met at their boundaries (the regular ones: they are the same forwards and
         backwards, and contacts come with their own substep boundaries), starting from
-        ``fastest``, the interval's start's (`_squared_rate`)."""
+        ``fastest``, the interval's start's (`_squared_rate`, with the ``total`` energy J at the
+        start, and the energy the velocity forces gave since)."""
         t = now
         contacts = 0
+        given = tally.forces[0]
         s = 1
         while s <= n:
             if flight is not None:  # as many substeps as meet no contact, compiled
-                s, t, fastest = flight.substeps(particles, field, now, dt, s, n, t, fastest)
+                s, t, fastest = flight.substeps(particles, field, now, dt, s, n, t, fastest, total)
                 if s > n:
                     break
             end = now + dt * s / n
             while t < end:  # substeps shortened for contacts end at a contact, not at ``end``
-                t = self._substep(particles, vessel, field, drift, t, end, dt, tally)
+                t = self._substep(particles, vessel, field, drift, t, end, dt, tally, s == n)
                 contacts += t < end
                 if contacts > MAX_CONTACTS:
                     raise SimulationError(
@@ -299,7 +307,8 @@ class AdaptiveLeapfrog(Integrator):
                         f"at t = {now:.6g} s, each a force evaluation: try a smaller dt, or "
                         f'collisions = "step"'
                     )
-            fastest = max(fastest, _squared_rate(particles, vessel, field))
+            now_total = total + float(tally.forces[0] - given)
+            fastest = max(fastest, _squared_rate(particles, vessel, field, now_total))
             s += 1
         return fastest
 
@@ -313,9 +322,11 @@ class AdaptiveLeapfrog(Integrator):
         end: float,
         dt: float,
         tally: Tally,
+        last: bool,
     ) -> float:
         """One kick-drift-kick from ``t`` to ``end`` (s), or to just before the first contact of
-        forced particles on the way; returns the time reached.
+        forced particles on the way; returns the time reached. It closes the step if it reaches
+        ``end`` and that is the interval's (``last``).
 
         A contact that the kick-drift-kick parabola puts within `CONTACT_WINDOW` of the start
         (a disk resting on a floor under gravity, which a shortened substep would meet again
@@ -341,7 +352,7 @@ class AdaptiveLeapfrog(Integrator):
                 drift.drift(particles, vessel, t, h, tally, acceleration, fall=fall)
                 break
             halt_after = contact.time
-        _closing_kick(particles, vessel, field, h, tally)
+        _closing_kick(particles, vessel, field, h, tally, closes_step=last and reached == end)
         return reached
 
 
@@ -353,25 +364,30 @@ def _kick(particles: Particles, vessel: Vessel, field: ForceField, h: float, tal
 
 
 def _closing_kick(
-    particles: Particles, vessel: Vessel, field: ForceField, h: float, tally: Tally
+    particles: Particles,
+    vessel: Vessel,
+    field: ForceField,
+    h: float,
+    tally: Tally,
+    closes_step: bool = False,
 ) -> None:
     """What comes after the drift, in the mirror order of `_kick`: the forces at the new
-    positions, their kick ``a h / 2``, then the velocity forces for ``h / 2``."""
-    particles.velocity += (0.5 * h) * field.evaluate(particles, vessel)
+    positions (their evaluation `closes_step` or not: `ForceField.evaluate`), their kick
+    ``a h / 2``, then the velocity forces for ``h / 2``."""
+    particles.velocity += (0.5 * h) * field.evaluate(particles, vessel, closes_step)
     tally.forces[0] += field.advance(particles, vessel, 0.5 * h, first=False)
 
 
-def _squared_rate(particles: Particles, vessel: Vessel, field: ForceField) -> float:
+def _squared_rate(particles: Particles, vessel: Vessel, field: ForceField, total: float) -> float:
     """The squared rate of the forces weighted by energy, 1/s^2: ``sqrt(S)`` (the energy error per
     squared second of the pair hardest to follow, `ForceField.stiffness`) over the total energy
-    ``|KE + U|``, the scale the energy error is judged against, but never below a tenth of
-    ``KE + |U|`` (a total near zero would ask for endless substeps). A leapfrog step h then errs on
-    the energy by about ``h^2 rate^2`` of that scale. The velocity forces' own rate
-    (`ForceField.rate`) counts too: a substep turns or damps a velocity by at most
-    ``tolerance`` of it."""
+    ``|KE + U|`` (``total``, J), the scale the energy error is judged against, but never below a
+    tenth of ``KE + |U|`` (a total near zero would ask for endless substeps;
+    `collidium.kernels.substeps.energy_scale`). A leapfrog step h then errs on the energy by
+    about ``h^2 rate^2`` of that scale. The velocity forces' own rate (`ForceField.rate`) counts
+    too: a substep turns or damps a velocity by at most ``tolerance`` of it."""
     kinetic = substeps.kinetic_energy(particles.mass, particles.velocity)
-    potential = field.potential(particles, vessel)
-    scale = max(abs(kinetic + potential), (kinetic + abs(potential)) / TOTAL_ENERGY_FLOOR)
+    scale = substeps.energy_scale(kinetic, total, TOTAL_ENERGY_FLOOR)
     energy = math.sqrt(field.stiffness(particles, vessel)) / scale if scale > 0.0 else 0.0
     return max(energy, field.rate(particles, vessel) ** 2)
 
@@ -494,9 +510,9 @@ class _SmoothFlight:
             )
         )
 
-    def squared_rate(self, particles: Particles, field: ForceField) -> float:
+    def squared_rate(self, particles: Particles, field: ForceField, total: float) -> float:
         """`_squared_rate` of the current state, compiled (the same to round-off)."""
-        _, _, rate2 = self.substeps(particles, field, 0.0, 0.0, 1, 0, 0.0, -1.0)
+        _, _, rate2 = self.substeps(particles, field, 0.0, 0.0, 1, 0, 0.0, -1.0, total)
         return rate2
 
     def substeps(
@@ -509,15 +525,16 @@ class _SmoothFlight:
         count: int,
         t: float,
         fastest: float,
+        total: float,
     ) -> tuple[int, float, float]:
         """Regular substeps from ``first`` of ``count`` up to the first that may meet a
-        contact (`collidium.kernels.substeps.smooth_substeps`): ``(that substep, its start in
-        s, the largest squared rate)``. The field's acceleration is kept current; its energies
-        are evaluated again when read."""
+        contact (`collidium.kernels.substeps.smooth_substeps`, given the ``total`` energy J):
+        ``(that substep, its start in s, the largest squared rate)``. The field's acceleration
+        is kept current; its energies are summed again when read."""
         return substeps.smooth_substeps(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
             self.sources, self.couplings, self.softening2, *self.walls, now, dt, first, count, t,
-            fastest, TOTAL_ENERGY_FLOOR,
+            fastest, total, TOTAL_ENERGY_FLOOR,
         )  # fmt: skip
 
 

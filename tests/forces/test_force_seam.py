@@ -82,6 +82,42 @@ def test_force_is_minus_the_gradient_of_its_potential(name):
     np.testing.assert_allclose(force, -gradient, rtol=0, atol=1e-8 * np.abs(force).max())
 
 
+@pytest.mark.parametrize("name", POSITION_FORCES)
+def test_a_kick_sums_the_same_forces_without_the_energies(name):
+    """Without ``energies`` (a kick) a force may skip its energies, never change its forces."""
+    particles, box = _scattered()
+    forces = []
+    for energies in (True, False):
+        force = np.full((particles.n, 2), np.nan)
+        EXAMPLES[name].compute(particles, box, force, np.empty(7), np.empty(7), {}, energies)
+        forces.append(force)
+    np.testing.assert_array_equal(forces[0], forces[1])
+
+
+def test_the_field_sums_energies_when_they_are_read(monkeypatch):
+    """Evaluations sum forces alone; a read of the potential or the virial sums the energies
+    (once for both); an evaluation that closes a step sums them with the forces only when the
+    energies of the step before were read."""
+    asked: list[bool] = []
+    compute = Coulomb.compute
+    monkeypatch.setattr(Coulomb, "compute", lambda self, *args: asked.append(args[-1])
+                        or compute(self, *args))  # fmt: skip
+    particles, box = _scattered()
+    field = ForceField((EXAMPLES["coulomb"],))
+    field.evaluate(particles, box)
+    field.evaluate(particles, box, closes_step=True)
+    assert asked == [False, False]
+    potential, virial = field.potential(particles, box), field.virial(particles, box)
+    assert asked == [False, False, True]
+    field.evaluate(particles, box, closes_step=True)  # read since the last close: with energies
+    assert asked[-1] is True
+    assert (field.potential(particles, box), field.virial(particles, box)) == (potential, virial)
+    assert len(asked) == 4  # read from that evaluation
+    field.evaluate(particles, box, closes_step=True)
+    field.evaluate(particles, box, closes_step=True)  # not read since: forces alone
+    assert asked == [False, False, True, True, True, False]
+
+
 @pytest.mark.parametrize("name", ["coulomb", "newton"])
 def test_pair_forces_sum_to_zero(name):
     particles, box = _scattered()

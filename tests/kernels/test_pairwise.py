@@ -116,7 +116,7 @@ def test_rows_in_serial_and_in_parallel_are_bitwise_the_same(rng, periodic):
     outputs = []
     for rows in (pairwise.direct_serial, pairwise.direct_parallel):
         force, energy, virial = np.full((n, 2), np.nan), np.full(n, np.nan), np.full(n, np.nan)
-        rows(position, charge, 5.0, 0.01, 100.0, 100.0, periodic, force, energy, virial)
+        rows(position, charge, 5.0, 0.01, 100.0, 100.0, periodic, force, energy, virial, True)
         outputs.append((force, energy, virial))
     for a, b in zip(*outputs, strict=True):
         assert np.isfinite(a).all()
@@ -126,6 +126,27 @@ def test_rows_in_serial_and_in_parallel_are_bitwise_the_same(rng, periodic):
         for rows in (pairwise.stiffness_serial, pairwise.stiffness_parallel)
     ]
     assert stiffness[0] > 0.0 and stiffness[0] == stiffness[1]
+
+
+# One task (up to 128 charges), a task per pair of block rows on one thread, and in parallel.
+@pytest.mark.parametrize("n", [40, 200, 2 * PARALLEL_DIRECT_FROM])
+@pytest.mark.parametrize("periodic", [False, True])
+def test_forces_alone_are_bitwise_those_summed_with_the_energies(rng, n, periodic):
+    """A kick sums the forces alone: the same bits as with the energies (so that reading the
+    energies never changes a trajectory), and the energy arrays left as they were."""
+    position = rng.uniform(-8, 8, (n, 2))
+    charge = rng.choice([-1.0, 1.0, 0.5, 0.0], n)
+    size = np.array([16.0, 16.0]) if periodic else None
+    with_energies = _coulomb(position, charge, eps2=0.01, size=size)[0]
+    alone = np.full((n, 2), np.nan)
+    w, h = size if periodic else (0.0, 0.0)
+    inverse_distance_direct(position, charge, 5.0, 0.01, w, h, periodic, alone)
+    np.testing.assert_array_equal(alone, with_energies)
+    for rows in (pairwise.direct_serial, pairwise.direct_parallel):
+        force, energy, virial = np.full((n, 2), np.nan), np.full(n, 7.0), np.full(n, 7.0)
+        rows(position, charge, 5.0, 0.01, w, h, periodic, force, energy, virial, False)
+        np.testing.assert_array_equal(force, with_energies)
+        assert np.all(energy == 7.0) and np.all(virial == 7.0)
 
 
 def test_neutral_particles_feel_and_exert_nothing(rng):

@@ -37,6 +37,13 @@ def accelerations(position, mass, sources, couplings, softening2):
     return force / mass[:, None]
 
 
+def energy(position, sources, couplings, softening2):
+    return sum(
+        float(reference.inverse_distance_direct(position, q, c, e)[1].sum())
+        for q, c, e in zip(sources, couplings, softening2, strict=True)
+    )
+
+
 WALLS = {
     "box": (BOX, np.array([5.0, 5.0]), np.nan, NONE),
     "circle": (CIRCLE, np.array([5.0, 5.0]), 5.0, NONE),
@@ -52,13 +59,14 @@ def test_substeps_equal_their_twin(rng, vessel, speed):
     shape, half, rim, table = WALLS[vessel]
     position, velocity, mass, radius, sources, couplings, softening2 = scene(rng, 12, speed=speed)
     acceleration = accelerations(position, mass, sources, couplings, softening2)
+    total = kinetic_energy(mass, velocity) + energy(position, sources, couplings, softening2)
     got = [a.copy() for a in (position, velocity, acceleration)]
     want = [a.copy() for a in (position, velocity, acceleration)]
     step, t, fastest = smooth_substeps(*got, mass, radius, sources, couplings, softening2, shape,
                                        half[0], half[1], rim, table, 1.0, 0.1, 1, 16, 1.0, 0.0,
-                                       FLOOR)  # fmt: skip
+                                       total, FLOOR)  # fmt: skip
     twin = reference.smooth_substeps(*want, mass, radius, sources, couplings, softening2, shape,
-                                     half, rim, table, 1.0, 0.1, 1, 16, 1.0, 0.0, FLOOR,
+                                     half, rim, table, 1.0, 0.1, 1, 16, 1.0, 0.0, total, FLOOR,
                                      CONTACT_MARGIN)  # fmt: skip
     assert (step, t) == twin[:2]
     assert (step == 17) == (speed < 1.0)
@@ -84,9 +92,10 @@ def test_a_crowd_stops_where_its_all_pairs_twin_stops(rng):
                 np.zeros(1), BOX)  # fmt: skip
         got, want = (position.copy(), velocity.copy()), (position.copy(), velocity.copy())
         step, t, _ = smooth_substeps(*got, *args, 20.0, 20.0, np.nan, NONE, 0.0, 2.0, 1, 64, 0.0,
-                                     0.0, FLOOR)  # fmt: skip
+                                     0.0, 1.0, FLOOR)  # fmt: skip
         twin = reference.smooth_substeps(*want, *args, np.array([20.0, 20.0]), np.nan, NONE, 0.0,
-                                         2.0, 1, 64, 0.0, 0.0, FLOOR, CONTACT_MARGIN)  # fmt: skip
+                                         2.0, 1, 64, 0.0, 0.0, 1.0, FLOOR,
+                                         CONTACT_MARGIN)  # fmt: skip
         assert (step, t) == twin[:2]
         np.testing.assert_allclose(got[0], want[0], rtol=1e-12, atol=1e-12)
         steps.append(step)
@@ -104,7 +113,7 @@ def test_a_disk_bound_for_a_wall_stops_the_substeps_just_before_it():
     sources = np.zeros((1, 2))
     step, t, _ = smooth_substeps(position, velocity, acceleration, mass, radius, sources,
                                  np.array([5.0]), np.zeros(1), BOX, 5.0, 5.0, np.nan, NONE, 0.0,
-                                 0.16, 1, 16, 0.0, 0.0, FLOOR)  # fmt: skip
+                                 0.16, 1, 16, 0.0, 0.0, 50.0, FLOOR)  # fmt: skip
     # The wall's contact is at x = 4.9, 0.1 s on: substeps 1 to 9 end at 0.09 s.
     assert (step, t) == (10, pytest.approx(0.09, rel=1e-15))
     np.testing.assert_allclose(position[0], [3.9 + 0.9, 0.0], rtol=1e-14)
@@ -120,7 +129,7 @@ def test_a_grazing_pair_stops_the_substeps_within_the_margin(miss):
     velocity = np.array([[5.0, 0.0], [-5.0, 0.0]])
     args = (np.zeros((2, 2)), np.ones(2), np.full(2, 0.5 * sigma), np.zeros((1, 2)),
             np.array([5.0]), np.zeros(1), BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.4, 1, 4, 0.0, 0.0,
-            FLOOR)  # fmt: skip
+            25.0, FLOOR)  # fmt: skip
     step, _, _ = smooth_substeps(position, velocity, *args)
     assert step == (5 if miss > CONTACT_MARGIN else 2)  # they meet in the second 0.1 s
 
@@ -135,7 +144,7 @@ def test_infinite_accelerations_stop_the_substeps_with_nothing_changed():
     step, t, fastest = smooth_substeps(position, velocity, acceleration, np.array([1e-310, 1.0]),
                                        np.zeros(2), np.ones((1, 2)), np.array([5.0]), np.zeros(1),
                                        BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.1, 1, 4, 0.0, 0.0,
-                                       FLOOR)  # fmt: skip
+                                       2.5, FLOOR)  # fmt: skip
     assert (step, t, fastest) == (1, 0.0, 0.0)
     np.testing.assert_array_equal(position, before)
     np.testing.assert_array_equal(velocity, 0.0)

@@ -76,10 +76,11 @@ class Coulomb(InverseDistanceForce):
         energy: FloatArray,
         virial: FloatArray,
         work: dict[str, np.ndarray],
+        energies: bool,
     ) -> None:
         """The pair sum of the charges (`collidium.forces.base.Force.compute`), then the
         limiter, if any, on each particle's force over its mass."""
-        super().compute(particles, vessel, force, energy, virial, work)
+        super().compute(particles, vessel, force, energy, virial, work, energies)
         if self.max_acceleration is not None:
             pull = np.hypot(force[:, 0], force[:, 1]) / particles.mass
             force /= np.sqrt(1.0 + (pull / self.max_acceleration) ** 2)[:, None]

@@ -83,12 +83,15 @@ class FieldMap:
         energy: FloatArray,
         virial: FloatArray,
         work: dict[str, np.ndarray],
+        energies: bool,
     ) -> None:
         """``-q grad phi``, ``q phi`` and no virial (`collidium.forces.base.PositionForce`)."""
         phi, slope_x, slope_y = self._interpolate(particles.position, vessel)
         charge = particles.charge
         force[:, 0] = -charge * slope_x
         force[:, 1] = -charge * slope_y
+        if not energies:
+            return
         energy[...] = charge * phi
         virial[...] = 0.0
 

@@ -75,18 +75,27 @@ def pair_sum(
     theta: float,
     particles: Particles,
     vessel: Vessel,
-    outputs: tuple[FloatArray, FloatArray, FloatArray],
+    force: FloatArray,
+    energies: tuple[FloatArray, FloatArray] | None,
     work: dict[str, np.ndarray],
 ) -> None:
-    """Forces (N, 2) in N, half pair energies and half pair virials (N,) in J, written into
-    ``outputs``, of sources ``source`` (N,) with ``coupling`` (`collidium.kernels.pairwise`).
+    """Forces (N, 2) in N written into ``force``, and if ``energies`` is given half pair
+    energies and half pair virials (N,) in J into its two arrays, of sources ``source`` (N,)
+    with ``coupling`` (`collidium.kernels.pairwise`).
 
-    ``work`` keeps the tree's buffers between calls (filled on first use)."""
-    force, energy, virial = outputs
+    ``work`` keeps the tree's buffers between calls (filled on first use). The tree sums the
+    energies with the forces whatever is asked (into a work array when not wanted): its far
+    field gives them for a few more terms of each expansion."""
     position = particles.position
     if uses_tree(method, particles, vessel):
         if not work:
             work.update(tree.tree_buffers(particles.n))
+        if energies is None:
+            unread = work.get("unread")
+            if unread is None or unread.shape[0] != particles.n:
+                unread = work["unread"] = np.empty(particles.n)
+            energies = unread, unread
+        energy, virial = energies
         tree.inverse_distance_tree(
             position, source, coupling, softening**2, force, energy, virial, work, theta=theta
         )
@@ -94,7 +103,7 @@ def pair_sum(
     width, height = (float(side) for side in vessel.size)  # the period, when periodic
     inverse_distance_direct(
         position, source, coupling, softening**2, width, height, vessel.periodic, force,
-        energy, virial,
+        *(energies or ()),
     )  # fmt: skip
 
 
@@ -164,11 +173,12 @@ class InverseDistanceForce:
         energy: FloatArray,
         virial: FloatArray,
         work: dict[str, np.ndarray],
+        energies: bool,
     ) -> None:
         """The pair sum of the sources (`collidium.forces.base.Force.compute`)."""
         pair_sum(
             getattr(particles, self.source), self.coupling, self.softening, self.method,
-            self.theta, particles, vessel, (force, energy, virial), work,
+            self.theta, particles, vessel, force, (energy, virial) if energies else None, work,
         )  # fmt: skip
 
     def stiffness(self, particles: Particles, vessel: Vessel, acceleration: FloatArray) -> float:

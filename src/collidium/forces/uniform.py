@@ -41,16 +41,19 @@ class UniformForce:
         energy: FloatArray,
         virial: FloatArray,
         work: dict[str, np.ndarray],
+        energies: bool,
     ) -> None:
         """``s_i f`` on each particle, ``-s_i f . x_i`` its energy, no virial
         (`collidium.forces.base.Force.compute`)."""
         fx, fy = getattr(self, self.vector)
         strength = getattr(particles, self.source)
+        force[:, 0] = strength * fx
+        force[:, 1] = strength * fy
+        if not energies:
+            return
         position = particles.position
         if vessel.periodic:
             position = position + particles.image * vessel.size
-        force[:, 0] = strength * fx
-        force[:, 1] = strength * fy
         energy[...] = -(position[:, 0] * force[:, 0] + position[:, 1] * force[:, 1])
         virial[...] = 0.0
 

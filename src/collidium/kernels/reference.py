@@ -820,6 +820,7 @@ def smooth_substeps(
     count: int,
     t: float,
     fastest: float,
+    total: float,
     energy_floor: float,
     margin: float,
 ) -> tuple[int, float, float]:
@@ -828,9 +829,9 @@ def smooth_substeps(
 
     Each substep: the kick; the contact test on all pairs and walls at once (contacts within
     ``margin`` of a radius, or of the substep); the straight flight; the forces
-    (`inverse_distance_direct`); the squared rate from the energies and
-    `inverse_distance_stiffness`. Updates the motion in place and returns ``(substep not
-    taken, its start, fastest)``.
+    (`inverse_distance_direct`); the squared rate from the ``total`` energy (the potential taken
+    as the total less the kinetic) and `inverse_distance_stiffness`. Updates the motion in place
+    and returns ``(substep not taken, its start, fastest)``.
     """
     zero = np.zeros(2)
     for s in range(first, count + 1):
@@ -855,11 +856,9 @@ def smooth_substeps(
         if not np.isfinite(kicked).all() or wall <= h * (1.0 + margin) or np.triu(meets, 1).any():
             return s, t, fastest
         flown = position + kicked * h
-        force, potential = np.zeros_like(position), 0.0
+        force = np.zeros_like(position)
         for source, coupling, eps2 in zip(sources, couplings, softening2, strict=True):
-            f, u, _ = inverse_distance_direct(flown, source, coupling, eps2)
-            force += f
-            potential += float(u.sum())
+            force += inverse_distance_direct(flown, source, coupling, eps2)[0]
         pull = force / mass[:, None]
         if not np.isfinite(pull).all():
             return s, t, fastest
@@ -872,6 +871,7 @@ def smooth_substeps(
             for source, coupling, eps2 in zip(sources, couplings, softening2, strict=True)
         )
         kinetic = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1)))
-        scale = max(abs(kinetic + potential), (kinetic + abs(potential)) / energy_floor)
+        potential = total - kinetic
+        scale = max(abs(total), (kinetic + abs(potential)) / energy_floor)
         fastest = max(fastest, math.sqrt(stiffness) / scale if scale > 0.0 else 0.0)
     return count + 1, t, fastest

@@ -40,10 +40,18 @@ def kinetic_energy(mass: np.ndarray, velocity: np.ndarray) -> float:
     return 0.5 * total
 
 
+@numba.njit(cache=True)
+def energy_scale(kinetic: float, total: float, floor: float) -> float:
+    """The energy (J) the substep rate judges the energy error against: ``|E|``, but at least
+    ``(KE + |U|) / floor``, with the potential ``U = E - KE`` (``total`` E and ``kinetic`` KE in
+    J); 0 only when there is no energy at all."""
+    return max(abs(total), (kinetic + abs(total - kinetic)) / floor)
+
+
 @numba.njit(cache=True, error_model="numpy")
 def smooth_substeps(
     position, velocity, acceleration, mass, radius, sources, couplings, softening2,
-    shape, half_width, half_height, rim, segments, now, dt, first, count, t, fastest,
+    shape, half_width, half_height, rim, segments, now, dt, first, count, t, fastest, total,
     energy_floor,
 ) -> tuple[int, float, float]:  # fmt: skip
     """Regular substeps ``first, first + 1, ...`` of ``count`` in the interval from ``now`` of
@@ -52,7 +60,8 @@ def smooth_substeps(
     Substep s ends at ``now + dt s / count``; it is a kick ``v += a h / 2``, the straight flight
     over h, the accelerations at the new positions and the kick ``v += a h / 2``. After each,
     the squared rate of the forces weighted by energy (`collidium.integrators._squared_rate`)
-    raises ``fastest``.
+    raises ``fastest``. No energy is summed: the rate's energy scale takes the potential as the
+    ``total`` energy less the kinetic (the forces conserve the total to the tolerance).
 
     Parameters
     ----------
@@ -75,8 +84,11 @@ def smooth_substeps(
     fastest : float
         Largest squared rate so far, 1/s^2; if negative, the rate of the state given (with
         ``first > count``, the call returns just that: the rate of an interval's start).
+    total : float
+        The total energy (kinetic and potential) at the interval's start, J.
     energy_floor : float
-        The rate's energy scale is ``|KE + U|`` but at least ``(KE + |U|) / energy_floor``.
+        The rate's energy scale is ``|KE + U|`` but at least ``(KE + |U|) / energy_floor``
+        (`energy_scale`).
 
     Returns
     -------
@@ -96,10 +108,8 @@ def smooth_substeps(
     order, low, high = np.arange(n), np.empty(n), np.empty(n)  # the sweep (`_meets_contact`)
     walls = (shape, half_width, half_height, rim, segments)
     if fastest < 0.0:
-        potential = _accelerations(position, mass, index, charged, counts, couplings, softening2,
-                                   moving, sums, pull)  # fmt: skip
         fastest = _squared_rate(position, velocity, mass, index, charged, inverse_mass, counts,
-                                couplings, softening2, moving, potential, energy_floor)  # fmt: skip
+                                couplings, softening2, moving, total, energy_floor)  # fmt: skip
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
@@ -112,8 +122,8 @@ def smooth_substeps(
         for i in range(n):
             for d in range(2):
                 flown[i, d] = position[i, d] + kicked[i, d] * h
-        potential = _accelerations(flown, mass, index, charged, counts, couplings, softening2,
-                                   moving, sums, pull)  # fmt: skip
+        _accelerations(flown, mass, index, charged, counts, couplings, softening2, moving, sums,
+                       pull)  # fmt: skip
         if not _finite(pull):
             return s, t, fastest
         for i in range(n):
@@ -123,7 +133,7 @@ def smooth_substeps(
                 acceleration[i, d] = pull[i, d]
         t = end
         rate2 = _squared_rate(position, velocity, mass, index, charged, inverse_mass, counts,
-                              couplings, softening2, moving, potential, energy_floor)  # fmt: skip
+                              couplings, softening2, moving, total, energy_floor)  # fmt: skip
         if rate2 > fastest:
             fastest = rate2
     return count + 1, t, fastest
@@ -163,11 +173,10 @@ def _accelerations(position, mass, index, charged, counts, couplings, softening2
                    out):  # fmt: skip
     """The accelerations (N, 2) of the pair forces into ``out`` (the sum of the forces over the
     masses, as `collidium.forces.base.ForceField.evaluate` forms them), by the pair sums of
-    `collidium.kernels.pairwise.inverse_distance_direct` in ``buffer`` (4 N (1 + MOST_BLOCKS / 2));
-    returns the potential energy, J."""
+    `collidium.kernels.pairwise.inverse_distance_direct` without energies, in ``buffer``
+    (4 N (1 + MOST_BLOCKS / 2))."""
     n = position.shape[0]
     out[:, :] = 0.0
-    potential = 0.0
     for f in range(counts.shape[0]):
         m = counts[f]
         x, y = work[0, :m], work[1, :m]
@@ -175,17 +184,15 @@ def _accelerations(position, mass, index, charged, counts, couplings, softening2
             x[c] = position[index[f, c], 0]
             y[c] = position[index[f, c], 1]
         sums = buffer[: 4 * m].reshape((4, m))  # contiguous, as `pair_sums` is compiled for
-        pair_sums(x, y, charged[f, :m], couplings[f], softening2[f], 0.0, 0.0, False, sums,
-                  buffer[4 * m :])  # fmt: skip
+        pair_sums(x, y, charged[f, :m], couplings[f], softening2[f], 0.0, 0.0, False, False,
+                  sums, buffer[4 * m :])  # fmt: skip
         for c in range(m):
             i = index[f, c]
             out[i, 0] += sums[0, c]
             out[i, 1] += sums[1, c]
-            potential += 0.5 * sums[2, c]
     for i in range(n):
         out[i, 0] /= mass[i]
         out[i, 1] /= mass[i]
-    return potential
 
 
 @numba.njit(cache=True, error_model="numpy")  # that of the inlined rows
@@ -210,13 +217,12 @@ def _stiffness(position, velocity, index, charged, inverse_mass, counts, couplin
 
 @numba.njit(cache=True, error_model="numpy")
 def _squared_rate(position, velocity, mass, index, charged, inverse_mass, counts, couplings,
-                  softening2, work, potential, floor) -> float:  # fmt: skip
-    """`collidium.integrators._squared_rate` of pair forces alone, 1/s^2, given the potential
-    energy (J) of the positions: the stiffness (`_stiffness`) over the energy scale."""
+                  softening2, work, total, floor) -> float:  # fmt: skip
+    """`collidium.integrators._squared_rate` of pair forces alone, 1/s^2, given the total
+    energy (J): the stiffness (`_stiffness`) over the energy scale."""
     stiffness = _stiffness(position, velocity, index, charged, inverse_mass, counts, couplings,
                            softening2, work)  # fmt: skip
-    kinetic = kinetic_energy(mass, velocity)
-    scale = max(abs(kinetic + potential), (kinetic + abs(potential)) / floor)
+    scale = energy_scale(kinetic_energy(mass, velocity), total, floor)
     return math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
 
 

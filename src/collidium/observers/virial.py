@@ -107,7 +107,7 @@ def _pair_sums(
     force, share, virial = np.empty((n, 2)), np.empty(n), np.empty(n)
     energy, total = np.zeros(n), 0.0
     for f in forces:
-        f.compute(particles, vessel, force, share, virial, {})
+        f.compute(particles, vessel, force, share, virial, {}, energies=True)
         energy += share
         total += float(np.sum(virial))
     return energy, total
