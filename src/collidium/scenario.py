@@ -392,13 +392,13 @@ def _plain(default: Any) -> Any:
 def _force_spec(name: str, cls: type) -> type[_ForceSpec]:
     """The schema model of a registered force, from its parameters (a required one as
     ``Field()``: pydantic 2.6 takes ``...`` beside an annotated type for its default)."""
-    fields: dict[str, Any] = {
+    fields: dict[str, Any] = {"type": (Literal[name], name)} | {
         key: (_schema_type(kind), Field() if default is dataclasses.MISSING else _plain(default))
         for key, (kind, default) in parameters(cls).items()
     }
     model: type[_ForceSpec] = create_model(
         f"{cls.__name__}Spec", __base__=_ForceSpec, __doc__=cls.__doc__, __module__=__name__,
-        type=(Literal[name], name), **fields,
+        **fields,
     )  # fmt: skip
     globals()[model.__name__] = model  # found by name, as pickle (a process pool) looks it up
     return model
