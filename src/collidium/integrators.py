@@ -287,10 +287,11 @@ class AdaptiveLeapfrog(Integrator):
         rate (1/s^2) met at their boundaries (the regular ones: they are the same forwards and
         backwards, and contacts come with their own substep boundaries), starting from
         ``fastest``, the interval's start's (`_squared_rate`, with the ``total`` energy J at the
-        start, and the energy the velocity forces gave since)."""
+        start and the energy given since: by the velocity forces, the walls, a piston and
+        inelastic collisions)."""
         t = now
         contacts = 0
-        given = tally.forces[0]
+        given = _given(tally)
         s = 1
         while s <= n:
             if flight is not None:  # as many substeps as meet no contact, compiled
@@ -307,7 +308,7 @@ class AdaptiveLeapfrog(Integrator):
                         f"at t = {now:.6g} s, each a force evaluation: try a smaller dt, or "
                         f'collisions = "step"'
                     )
-            now_total = total + float(tally.forces[0] - given)
+            now_total = total + (_given(tally) - given)
             fastest = max(fastest, _squared_rate(particles, vessel, field, now_total))
             s += 1
         return fastest
@@ -376,6 +377,12 @@ def _closing_kick(
     ``a h / 2``, then the velocity forces for ``h / 2``."""
     particles.velocity += (0.5 * h) * field.evaluate(particles, vessel, closes_step)
     tally.forces[0] += field.advance(particles, vessel, 0.5 * h, first=False)
+
+
+def _given(tally: Tally) -> float:
+    """The energy (J) given to the particles so far by the velocity forces, the walls, a piston
+    and inelastic collisions (negative: taken)."""
+    return float(tally.forces[0] + tally.heat.sum())
 
 
 def _squared_rate(particles: Particles, vessel: Vessel, field: ForceField, total: float) -> float:
