@@ -487,6 +487,19 @@ def test_truncated_files_give_one_line_on_every_command(tmp_path, kind):
     assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
 
 
+def test_a_bad_movie_name_is_refused_before_the_scenario_runs(tmp_path, monkeypatch, capsys):
+    from collidium import runner
+    from collidium.cli import main
+
+    def record(*args, **kwargs):
+        raise AssertionError("the scenario ran")
+
+    monkeypatch.setattr(runner, "record", record)
+    code = main(["render", "head-on", "--movie", str(tmp_path / "m.avi")])
+    assert code == 2
+    assert capsys.readouterr().err == "error: --movie: must end in .mp4 or .gif, got 'm.avi'\n"
+
+
 def test_movie_without_ffmpeg_falls_back_to_gif_with_a_one_line_warning(tmp_path, capsys):
     import sys as system
 

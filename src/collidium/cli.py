@@ -238,6 +238,8 @@ def render_command(
         raise InputError("--plots", "give --plots DIR and/or --movie FILE")
     if fps < 1:
         raise InputError("--fps", f"must be >= 1, got {fps}")
+    if movie is not None:
+        render.movie_path(movie)  # before a scenario runs for it
     trajectory = _trajectory_of(source, time, every, parse_settings(overrides or []))
     show = sys.stderr.isatty()
     if plots is not None:

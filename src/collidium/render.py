@@ -483,10 +483,8 @@ def write_movie(
     InputError
         For another suffix, no frames, or ``fps`` or ``dpi`` not > 0.
     """
-    path = Path(path)
+    path = movie_path(path)
     suffix = path.suffix.lower()
-    if suffix not in MOVIE_SUFFIXES:
-        raise InputError("--movie", f"must end in .mp4 or .gif, got {path.name!r}")
     for name, value in (("fps", fps), ("dpi", dpi)):
         if isinstance(value, bool) or not (isinstance(value, int | float) and value > 0):
             raise InputError(name, f"must be a number > 0, got {value!r}")
@@ -515,6 +513,15 @@ def write_movie(
     finally:
         pictures.close()
         movie.close()
+    return path
+
+
+def movie_path(path: str | Path) -> Path:
+    """``path`` as a movie's `Path`, refused (`InputError` naming ``--movie``) unless it ends
+    in one of `MOVIE_SUFFIXES`: the command line checks it before it runs a scenario."""
+    path = Path(path)
+    if path.suffix.lower() not in MOVIE_SUFFIXES:
+        raise InputError("--movie", f"must end in .mp4 or .gif, got {path.name!r}")
     return path
 
 
