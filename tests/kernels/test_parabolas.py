@@ -94,22 +94,27 @@ def test_distance_crossing_equals_its_twin(body, reach, outward):
     assert abs(np.linalg.norm(x) - reach) <= 64 * EPS * size
 
 
+# The arguments are floats, as the engine passes them: integers would compile the kernel again.
 def test_an_outward_crossing_must_come_and_an_inward_one_may_not():
     # Dropped from the centre of a circle of reach 1 under g = 1: |y| = t^2 / 2 = 1 at sqrt(2).
-    assert parabolas.distance_crossing(0, 0, 0, 0, 0, -1.0, 1.0, True, math.inf) == pytest.approx(
-        math.sqrt(2.0), rel=1e-15
-    )
+    assert parabolas.distance_crossing(
+        0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 1.0, True, math.inf
+    ) == pytest.approx(math.sqrt(2.0), rel=1e-15)
     # Thrown up past a point 2 m to the side, never within 1 m of it.
-    assert math.isinf(parabolas.distance_crossing(-2.0, 0, 0, 1.0, 0, -1.0, 1.0, False, math.inf))
+    assert math.isinf(
+        parabolas.distance_crossing(-2.0, 0.0, 0.0, 1.0, 0.0, -1.0, 1.0, False, math.inf)
+    )
     # A horizon before the crossing: none found.
-    assert math.isinf(parabolas.distance_crossing(0, 0, 0, 0, 0, -1.0, 1.0, True, 1.0))
+    assert math.isinf(parabolas.distance_crossing(0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 1.0, True, 1.0))
 
 
 def test_a_body_across_moving_on_gets_zero_and_one_moving_back_gets_its_turn():
     # A hair outside the rim and moving out: at once.
-    assert parabolas.distance_crossing(1.0 + 1e-15, 0, 1.0, 0, 0, -1.0, 1.0, True, math.inf) == 0
+    assert (
+        parabolas.distance_crossing(1.0 + 1e-15, 0.0, 1.0, 0.0, 0.0, -1.0, 1.0, True, math.inf) == 0
+    )
     # A hair outside, moving in, but pulled out again before getting inside: when it turns.
-    turn = parabolas.distance_crossing(1.0 + 1e-12, 0, -1e-7, 0, 1.0, 0, 1.0, True, math.inf)
+    turn = parabolas.distance_crossing(1.0 + 1e-12, 0.0, -1e-7, 0.0, 1.0, 0.0, 1.0, True, math.inf)
     assert turn == pytest.approx(1e-7, rel=1e-6)  # v + g t = 0
 
 
