@@ -122,3 +122,25 @@ def test_tree_driven_run_conserves_energy():
     direct_drift, tree_drift = drifts
     assert direct_drift < 2e-3  # leapfrog at dt = 0.01 s in this strongly coupled plasma
     assert abs(tree_drift - direct_drift) < 1e-4  # the tree adds nothing visible to it
+
+
+@pytest.mark.parametrize("method", ["direct", "tree"])
+def test_a_shared_charge_and_charges_of_their_own_run_one_compiled_sum(rng, method):
+    """A charge all particles share is a read-only view (`Particles`); the pair kernels get it
+    as a plain array, so both scenes run the same compiled sum and stiffness."""
+    from collidium.kernels import pairwise, tree
+
+    kernels = (pairwise.direct_serial, pairwise.stiffness_serial, tree.build_tree)
+    position = rng.uniform(-5, 5, (30, 2))
+    shared = Particles(position, rng.normal(0, 1, (30, 2)), charge=1.0, mass=2.0)
+    own = Particles(position, shared.velocity, charge=np.ones(30), mass=np.full(30, 2.0))
+    field = ForceField((Coulomb(method=method),))
+    box = Box(20, 20)
+    compiled = []
+    for particles in (shared, own):
+        acceleration = field.evaluate(particles, box).copy()
+        stiffness = field.stiffness(particles, box)
+        compiled.append([set(kernel.signatures) for kernel in kernels])
+    assert compiled[0] == compiled[1]
+    np.testing.assert_array_equal(field.evaluate(shared, box), acceleration)
+    assert field.stiffness(shared, box) == stiffness

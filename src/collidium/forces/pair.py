@@ -60,6 +60,16 @@ def check_vessel(name: str, method: str, vessel: Vessel) -> None:
         )
 
 
+def writable(values: FloatArray) -> FloatArray:
+    """``values`` (N,) as a contiguous writable array, copied if it is not one: a value all
+    particles share is a read-only view of stride 0 (`collidium.state.Particles`), another type
+    to numba, which would compile the pair kernels a second time for it (O(N) against their
+    O(N log N) or O(N^2))."""
+    if values.flags.c_contiguous and values.flags.writeable:
+        return values
+    return np.array(values)
+
+
 def uses_tree(method: str, particles: Particles, vessel: Vessel) -> bool:
     """Whether a pair force with this ``method`` sums by tree here."""
     if vessel.periodic or method == "direct":
@@ -128,7 +138,7 @@ def pair_stiffness(
     if not uses_tree(method, particles, vessel):
         width, height = (float(side) for side in vessel.size)
         return inverse_distance_stiffness(
-            particles.position, particles.velocity, source, particles.mass, coupling,
+            particles.position, particles.velocity, source, writable(particles.mass), coupling,
             softening**2, width, height, vessel.periodic,
         )  # fmt: skip
     length = np.maximum(2.0 * particles.radius, softening)
@@ -177,14 +187,14 @@ class InverseDistanceForce:
     ) -> None:
         """The pair sum of the sources (`collidium.forces.base.Force.compute`)."""
         pair_sum(
-            getattr(particles, self.source), self.coupling, self.softening, self.method,
+            writable(getattr(particles, self.source)), self.coupling, self.softening, self.method,
             self.theta, particles, vessel, force, (energy, virial) if energies else None, work,
         )  # fmt: skip
 
     def stiffness(self, particles: Particles, vessel: Vessel, acceleration: FloatArray) -> float:
         """How fast the pair energies change (`pair_stiffness`)."""
         return pair_stiffness(
-            getattr(particles, self.source), self.coupling, self.softening, self.method,
+            writable(getattr(particles, self.source)), self.coupling, self.softening, self.method,
             particles, vessel, acceleration,
         )  # fmt: skip
 
