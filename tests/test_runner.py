@@ -209,3 +209,39 @@ def test_frames_come_every_tenth_of_a_second_by_default(dt, every):
     spec = load_scenario("gas", n=10, dt=dt)
     _, job = prepare(spec, steps=1)
     assert job.every == every
+
+
+def test_ctrl_c_just_after_a_frame_names_the_frames_the_file_holds(tmp_path, monkeypatch):
+    """A Ctrl-C between a frame's write and the writer's note of it: the line names the last
+    frame in the file, not the one before."""
+    import gsd.hoomd
+
+    from collidium.errors import Interrupted
+    from collidium.runner import execute, prepare
+
+    opened = gsd.hoomd.open
+
+    class InterruptedAfterFifth:
+        def __init__(self, file):
+            self.file, self.appended = file, 0
+
+        def append(self, frame):
+            self.file.append(frame)
+            self.appended += 1
+            if self.appended == 5:
+                raise KeyboardInterrupt
+
+        def __getattr__(self, name):
+            return getattr(self.file, name)
+
+    def open_gsd(path, mode="r"):
+        file = opened(path, mode)
+        return InterruptedAfterFifth(file) if mode == "w" else file
+
+    monkeypatch.setattr(gsd.hoomd, "open", open_gsd)
+    sim, job = prepare(load_scenario("head-on"), steps=50, out=tmp_path / "r.gsd", every=2)
+    with pytest.raises(Interrupted) as caught:
+        execute(sim, job)
+    last = int(read_trajectory(tmp_path / "r.gsd").step[-1])
+    assert last == 8  # frames at steps 0, 2, 4, 6 and 8
+    assert f"(frames to step {last})" in str(caught.value)

@@ -325,11 +325,10 @@ def execute(sim: Simulation, job: Job, progress: bool = False) -> dict[str, Any]
         try:
             sim.run(steps=remaining, progress=progress)
         except KeyboardInterrupt:
+            _close_trajectories(sim)  # first: the line names the frames the files hold
             raise Interrupted(_where_stopped(sim, job)) from None
-        finally:  # this run's trajectory and any a scenario file asked for
-            for observer in sim.observers:
-                if isinstance(observer, GSDWriter):
-                    observer.close()
+        finally:
+            _close_trajectories(sim)
     wall = clock.perf_counter() - start
     if job.checkpoint is not None and remaining > 0:
         save(sim, job, drift)
@@ -341,11 +340,18 @@ def execute(sim: Simulation, job: Job, progress: bool = False) -> dict[str, Any]
     return summarise(sim, job, thermo, rate, wall, reported)
 
 
+def _close_trajectories(sim: Simulation) -> None:
+    """Close this run's trajectory and any a scenario file asked for."""
+    for observer in sim.observers:
+        if isinstance(observer, GSDWriter):
+            observer.close()
+
+
 def _where_stopped(sim: Simulation, job: Job) -> str:
     """One line for Ctrl-C: the step and time the run stopped at, and the files kept."""
     kept = []
     for observer in sim.observers:
-        if isinstance(observer, GSDWriter) and observer.frames_written:
+        if isinstance(observer, GSDWriter) and observer.last_step >= 0:
             name = job.out if job.staged and observer.path == job.trajectory else observer.path
             kept.append(f"{name} (frames to step {observer.last_step})")
         if isinstance(observer, CheckpointWriter) and observer.saved_step is not None:

@@ -237,13 +237,18 @@ class GSDWriter:
         self._unflushed_since = None
 
     def close(self) -> None:
-        """Flush and close the file."""
+        """Flush and close the file; `last_step` is then read back from it (a Ctrl-C between
+        a frame's append and its bookkeeping would otherwise leave them apart)."""
+        import gsd.hoomd
+
         file, self._file = self._file, None
         self._unflushed_since = None
         if file is not None:
             self.append = True  # reopening continues the same file
             with self._writing():
                 file.close()
+                with gsd.hoomd.open(self.path, "r") as written:
+                    self._last_step = int(written[-1].configuration.step) if written else -1
 
     @contextmanager
     def _writing(self) -> Iterator[None]:
