@@ -100,8 +100,8 @@ def inverse_distance_direct(
         Output: half the pair energy of each particle with all others, J (sum = total potential).
     virial : ndarray, shape (N,), optional
         Output: half of ``sum_j r_ij . F_ij`` for each particle, J (sum = the pair virial).
-        Without both, the loop sums the forces alone (a kick needs no more), about a fifth
-        faster; the forces are bitwise the same either way.
+        Without both, they are not written (the loop sums them anyway: `_tile`); the forces
+        are the same either way.
     """
     rows = direct_parallel if position.shape[0] >= PARALLEL_DIRECT_FROM else direct_serial
     energies = energy is not None and virial is not None
@@ -167,18 +167,14 @@ def _blocks(m: int) -> tuple[int, int, int]:
 
 
 @numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def _tile(first, second, size, x, y, q, coupling, softening2, width, height, periodic, energies,
-          sums):  # fmt: skip
+def _tile(first, second, size, x, y, q, coupling, softening2, width, height, periodic, sums):
     """The pairs of block ``first`` with block ``second`` (each pair of the block once when they
-    are the same), added to both particles' ``sums`` (4, m): force x, y, and if ``energies``
-    the pair energy and ``r . F``.
+    are the same), added to both particles' ``sums`` (4, m): force x, y, pair energy, ``r . F``.
 
-    Without the energies the loop skips their sums on the j side, the most costly part of them
-    (the branch is the same every pass: LLVM makes two loops of it, as of ``periodic``), and
-    rows 2 and 3 of ``sums`` are meaningless. The i side keeps summing them: the two loops then
-    have the same reductions, which LLVM splits into the same partial sums, so the forces come
-    out bitwise the same either way (a test checks it); dropped there too, the forces changed
-    in their last bits.
+    The energies are summed whether or not they are wanted: a loop without their sums on the j
+    side was a fifth faster, but the forces are then bitwise the same as this loop's only as
+    long as LLVM splits both loops' reductions alike, which LLVM 14 (numba 0.59) did not, and
+    watching a run (reading its energies) would have changed its bits.
 
     The pair loops count with unsigned integers: a signed j could be negative, which numba
     wraps around, and LLVM would then gather the loads, four times slower."""
@@ -200,22 +196,20 @@ def _tile(first, second, size, x, y, q, coupling, softening2, width, height, per
             f, uij = inverse_distance_pair(r2, kqi * q[j], softening2)
             fx += f * dx
             fy += f * dy
-            sums[0, j] -= f * dx
-            sums[1, j] -= f * dy
             u += uij
             w += f * r2
-            if energies:
-                sums[2, j] += uij
-                sums[3, j] += f * r2
+            sums[0, j] -= f * dx
+            sums[1, j] -= f * dy
+            sums[2, j] += uij
+            sums[3, j] += f * r2
         sums[0, i] += fx
         sums[1, i] += fy
-        sums[2, i] += u  # stored either way, else LLVM drops the i side's energies too
+        sums[2, i] += u
         sums[3, i] += w
 
 
 @numba.njit(cache=True)
-def _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, energies,
-          sums) -> None:  # fmt: skip
+def _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums) -> None:
     """Task t of the pair sums: the tiles of block rows t and ``blocks - 1 - t`` (each tile of a
     row with itself and the blocks after it) into its own ``sums`` (4, m), zeroed first."""
     _zero(sums)
@@ -223,7 +217,7 @@ def _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodi
     for first in range(t, mirror + 1, max(1, mirror - t)):  # rows t and mirror (once if one)
         for second in range(first, blocks):
             _tile(first, second, size, x, y, q, coupling, softening2, width, height, periodic,
-                  energies, sums)  # fmt: skip
+                  sums)  # fmt: skip
 
 
 @numba.njit(cache=True, inline="always")
@@ -246,10 +240,9 @@ def _zero(sums) -> None:
 
 
 @numba.njit(cache=True)
-def pair_sums(x, y, q, coupling, softening2, width, height, periodic, energies, sums,
-              buffer) -> None:  # fmt: skip
-    """Every pair's force x, y, and if ``energies`` its energy and ``r . F``, on both particles
-    into ``sums`` (4, m), each pair once, on the calling thread: task by task, each in a buffer
+def pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buffer) -> None:
+    """Every pair's force x, y, energy and ``r . F`` on both particles into ``sums`` (4, m),
+    each pair once, on the calling thread: task by task, each in a buffer
     of its own, the buffers then added up in task order, as `direct_parallel` does on all
     threads, so both give the same bits.
 
@@ -259,8 +252,6 @@ def pair_sums(x, y, q, coupling, softening2, width, height, periodic, energies, 
         Contiguous coordinates (m) and sources of the particles with a source.
     coupling, softening2, width, height, periodic
         As in `inverse_distance_direct`.
-    energies : bool
-        Whether to sum the energies and virials too (else their rows are meaningless).
     sums : ndarray, shape (4, m)
         Output: force x and y (N), the sum of the pair energies (J) and of ``r_ij . F_ij``.
     buffer : ndarray, shape (4 * m * tasks,) at least
@@ -270,13 +261,11 @@ def pair_sums(x, y, q, coupling, softening2, width, height, periodic, energies, 
     m = x.shape[0]
     size, blocks, tasks = _blocks(m)
     if tasks == 1:  # as `direct_parallel` does
-        _task(0, blocks, size, x, y, q, coupling, softening2, width, height, periodic, energies,
-              sums)  # fmt: skip
+        _task(0, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
         return
     buffers = buffer[: tasks * 4 * m].reshape((tasks, 4, m))
     for t in range(tasks):
-        _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, energies,
-              buffers[t])  # fmt: skip
+        _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, buffers[t])
     _total(buffers, sums)
 
 
@@ -305,13 +294,12 @@ def direct_parallel(position, source, coupling, softening2, width, height, perio
     size, blocks, tasks = _blocks(m)
     sums = np.empty((4, m))
     if tasks == 1:  # one task sums into ``sums`` itself, as in `pair_sums`
-        _task(0, blocks, size, x, y, q, coupling, softening2, width, height, periodic, energies,
-              sums)  # fmt: skip
+        _task(0, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
     else:
         buffers = np.empty((tasks, 4, m))
         for t in numba.prange(tasks):
             _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic,
-                  energies, buffers[t])  # fmt: skip
+                  buffers[t])  # fmt: skip
         _total(buffers, sums)
     _scatter(sums, index, force, energy, virial, energies)
 
@@ -325,7 +313,7 @@ def direct_serial(position, source, coupling, softening2, width, height, periodi
     sums = np.empty((4, m))
     tasks = _blocks(m)[2]
     buffer = np.empty(4 * m * tasks if tasks > 1 else 0)  # one task sums into ``sums``
-    pair_sums(x, y, q, coupling, softening2, width, height, periodic, energies, sums, buffer)
+    pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buffer)
     _scatter(sums, index, force, energy, virial, energies)
 
 

@@ -173,8 +173,8 @@ def _accelerations(position, mass, index, charged, counts, couplings, softening2
                    out):  # fmt: skip
     """The accelerations (N, 2) of the pair forces into ``out`` (the sum of the forces over the
     masses, as `collidium.forces.base.ForceField.evaluate` forms them), by the pair sums of
-    `collidium.kernels.pairwise.inverse_distance_direct` without energies, in ``buffer``
-    (4 N (1 + MOST_BLOCKS / 2))."""
+    `collidium.kernels.pairwise.inverse_distance_direct` in ``buffer`` (4 N (1 + MOST_BLOCKS /
+    2)); their energies are not used."""
     n = position.shape[0]
     out[:, :] = 0.0
     for f in range(counts.shape[0]):
@@ -184,8 +184,8 @@ def _accelerations(position, mass, index, charged, counts, couplings, softening2
             x[c] = position[index[f, c], 0]
             y[c] = position[index[f, c], 1]
         sums = buffer[: 4 * m].reshape((4, m))  # contiguous, as `pair_sums` is compiled for
-        pair_sums(x, y, charged[f, :m], couplings[f], softening2[f], 0.0, 0.0, False, False,
-                  sums, buffer[4 * m :])  # fmt: skip
+        pair_sums(x, y, charged[f, :m], couplings[f], softening2[f], 0.0, 0.0, False, sums,
+                  buffer[4 * m :])  # fmt: skip
         for c in range(m):
             i = index[f, c]
             out[i, 0] += sums[0, c]
