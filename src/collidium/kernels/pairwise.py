@@ -242,9 +242,9 @@ def _zero(sums) -> None:
 @numba.njit(cache=True)
 def pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buffer) -> None:
     """Every pair's force x, y, energy and ``r . F`` on both particles into ``sums`` (4, m),
-    each pair once, on the calling thread: task by task, each in a buffer
-    of its own, the buffers then added up in task order, as `direct_parallel` does on all
-    threads, so both give the same bits.
+    each pair once, on the calling thread: task by task, each in a buffer of its own, the
+    buffers then added up in task order, as `direct_parallel` does on all threads, so both give
+    the same bits.
 
     Parameters
     ----------
