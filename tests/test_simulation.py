@@ -342,3 +342,78 @@ def test_particles_added_and_removed_are_checked_and_keep_the_rest():
     np.testing.assert_allclose(sim.particles.velocity[1], [0.0, 2.0])
     with pytest.raises(Refused, match="indices: must be particles 0 to 1"):
         sim.remove_particles([5])
+
+
+class StateReader:
+    """Observer: reads the positions when its trigger fires (as a trajectory writer does)."""
+
+    def __init__(self, trigger: Every) -> None:
+        self.trigger = trigger
+        self.reads = 0
+
+    def attach(self, sim: cd.Simulation) -> None:
+        pass
+
+    def update(self, sim: cd.Simulation) -> None:
+        assert np.isfinite(sim.particles.position).all()
+        self.reads += 1
+
+
+@pytest.mark.parametrize(
+    ("name", "time"),
+    [("orbit", 3.0), ("bohr-atom", 1.0), ("charged-opposite", 8.0), ("charged-gas", 0.1)],
+)
+def test_steps_flown_in_one_call_are_bitwise_those_taken_one_by_one(name, time):
+    """A small charged scene flies the steps between the observers that read its state in one
+    compiled call: the run ends bit for bit as one whose observer reads every step, its energy
+    drift (read every step and every seventh) and its contacts included. charged-opposite
+    collides, the charged gas meets a contact in most substeps."""
+    runs = []
+    for reader in (StateReader(Every(250)), StateReader(Every(1))):
+        sim = cd.load(name)
+        drifts = [cd.observers.EnergyDrift(), cd.observers.EnergyDrift(7)]
+        sim.observers += [*drifts, reader]
+        sim.run(time=time)
+        runs.append((sim, drifts))
+    (flown, flown_drifts), (stepped, stepped_drifts) = runs
+    np.testing.assert_array_equal(flown.particles.position, stepped.particles.position)
+    np.testing.assert_array_equal(flown.particles.velocity, stepped.particles.velocity)
+    assert flown._integrator.substeps == stepped._integrator.substeps
+    assert flown.counters == stepped.counters
+    for ours, theirs in zip(flown_drifts, stepped_drifts, strict=True):
+        assert ours.samples == theirs.samples
+        assert ours.max_rel_drift == theirs.max_rel_drift > 0.0
+
+
+def test_small_scenes_fly_between_the_observers_that_read_the_state(monkeypatch):
+    """orbit flies its steps in compiled calls up to each firing of an observer that reads the
+    state, and at most `MOST_FLOWN` at once; an energy drift read every step does not stop it;
+    an observer that reads the state every step flies none. A progress bar changes no bit."""
+    from collidium import simulation
+    from collidium.integrators import AdaptiveLeapfrog
+
+    calls = []
+    fly = AdaptiveLeapfrog.fly
+
+    def counted(self, *args):
+        flown = fly(self, *args)
+        calls.append((args[-1].shape[0], flown))
+        return flown
+
+    monkeypatch.setattr(AdaptiveLeapfrog, "fly", counted)
+    sim = cd.load("orbit")
+    reader = StateReader(Every(40))
+    sim.observers += [cd.observers.EnergyDrift(), reader]
+    sim.run(steps=200)
+    assert reader.reads == 5
+    assert [run for run, _ in calls] == [40] * 5 and sum(f for _, f in calls) >= 190
+    calls.clear()
+    alone = cd.load("orbit").run(steps=2 * simulation.MOST_FLOWN + 10)
+    assert [run for run, _ in calls][:3] == [simulation.MOST_FLOWN] * 2 + [10]
+    calls.clear()
+    sim = cd.load("orbit")
+    sim.observers.append(StateReader(Every(1)))
+    sim.run(steps=50)
+    assert calls == []
+    shown = cd.load("orbit").run(steps=2 * simulation.MOST_FLOWN + 10, progress=True)
+    np.testing.assert_array_equal(shown.particles.position, alone.particles.position)

@@ -21,6 +21,7 @@ under a uniform gravity alone, whose parabolas it flies exactly (`ForceField.fal
 from __future__ import annotations
 
 import math
+import typing
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
@@ -30,7 +31,7 @@ import numpy as np
 from collidium.collisions import Contact, Drift, Tally
 from collidium.errors import SimulationError
 from collidium.forces import ForceField
-from collidium.kernels import substeps
+from collidium.kernels import substeps, sums
 from collidium.kernels.pairwise import PARALLEL_DIRECT_FROM
 from collidium.state import FloatArray, Particles
 from collidium.vessels import Vessel
@@ -121,6 +122,41 @@ class Integrator:
     ) -> None:
         raise NotImplementedError
 
+    def flies(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
+        """Whether `fly` may take steps here (none by default)."""
+        return False
+
+    def fly(
+        self,
+        particles: Particles,
+        vessel: Vessel,
+        field: ForceField,
+        origin: float,
+        elapsed: int,
+        dt: float,
+        kinetic: FloatArray,
+        potential: FloatArray,
+    ) -> int:
+        """Take up to ``len(kinetic)`` steps of ``dt`` (s) in one compiled call, as `step` would
+        take them one by one, bit for bit, up to the first that this call cannot take (which
+        is left as it began); returns how many it took.
+
+        Parameters
+        ----------
+        particles, vessel, field
+            As in `step`.
+        origin : float
+            The simulation's clock origin, s: step k starts at ``origin + (elapsed + k) dt``.
+        elapsed : int
+            Steps from the clock's origin to the first step's start.
+        dt : float
+            The reporting interval, s.
+        kinetic, potential : ndarray, shape (K,)
+            Output: the kinetic and potential energy (J) after each step taken, as
+            `collidium.simulation.Simulation.energy` gives them.
+        """
+        return 0
+
     def state(self) -> dict[str, np.ndarray]:
         """Arrays a checkpoint needs to continue bit for bit (none by default)."""
         return {}
@@ -210,10 +246,7 @@ class AdaptiveLeapfrog(Integrator):
     def needed(self, rate2: float, dt: float) -> int:
         """The fewest substeps, a power of two up to `MAX_SUBSTEPS`, that keep ``dt / n`` within
         ``tolerance`` times the time scale ``1 / sqrt(rate2)`` (``rate2`` in 1/s^2)."""
-        ratio = dt * math.sqrt(rate2) / self.tolerance
-        if not ratio <= MAX_SUBSTEPS:  # also NaN
-            return MAX_SUBSTEPS
-        return max(1, 1 << math.ceil(math.log2(ratio))) if ratio > 1.0 else 1
+        return int(substeps.needed(rate2, dt, self.tolerance, MAX_SUBSTEPS))
 
     def _with_forces(
         self,
@@ -225,11 +258,13 @@ class AdaptiveLeapfrog(Integrator):
         dt: float,
         tally: Tally,
     ) -> None:
-        start = _Snapshot(particles, tally)
         flight = self._flight_for(particles, vessel, field)
+        if flight is not None and self._fly(flight, particles, field, now, 0, dt, _ONE, _ONE):
+            return  # the interval met no contact: compiled whole
+        start = _Snapshot(particles, tally)
         # The energy the substeps' rate is judged against: the interval's one read of the
         # energies (the forces keep the total within the tolerance over the interval).
-        total = substeps.kinetic_energy(particles.mass, particles.velocity) + field.potential(
+        total = sums.kinetic_energy(particles.mass, particles.velocity) + field.potential(
             particles, vessel
         )
         rate2 = (
@@ -267,6 +302,46 @@ class AdaptiveLeapfrog(Integrator):
         if self._flight is None or not self._flight.fits(particles, vessel, field):
             self._flight = _SmoothFlight.of(particles, vessel, field)
         return self._flight
+
+    def flies(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
+        """Whether `fly` may take steps here: forces that kick, all direct pair sums, in a
+        small scene (`_SmoothFlight.of`)."""
+        return field.kicks and self._flight_for(particles, vessel, field) is not None
+
+    def fly(
+        self,
+        particles: Particles,
+        vessel: Vessel,
+        field: ForceField,
+        origin: float,
+        elapsed: int,
+        dt: float,
+        kinetic: FloatArray,
+        potential: FloatArray,
+    ) -> int:
+        """Whole intervals that meet no contact, compiled (`Integrator.fly`,
+        `collidium.kernels.substeps.smooth_intervals`): `step` takes each such interval by the
+        same call, so both give the same bits."""
+        if not self.flies(particles, vessel, field):
+            return 0
+        flight = typing.cast(_SmoothFlight, self._flight)
+        return self._fly(flight, particles, field, origin, elapsed, dt, kinetic, potential)
+
+    def _fly(
+        self,
+        flight: _SmoothFlight,
+        particles: Particles,
+        field: ForceField,
+        origin: float,
+        elapsed: int,
+        dt: float,
+        kinetic: FloatArray,
+        potential: FloatArray,
+    ) -> int:
+        flown, self.substeps = flight.intervals(
+            particles, field, origin, elapsed, dt, self.substeps, self.tolerance, kinetic, potential
+        )
+        return flown
 
     def _interval(
         self,
@@ -393,7 +468,7 @@ def _squared_rate(particles: Particles, vessel: Vessel, field: ForceField, total
     `collidium.kernels.substeps.energy_scale`). A leapfrog step h then errs on the energy by
     about ``h^2 rate^2`` of that scale. The velocity forces' own rate (`ForceField.rate`) counts
     too: a substep turns or damps a velocity by at most ``tolerance`` of it."""
-    kinetic = substeps.kinetic_energy(particles.mass, particles.velocity)
+    kinetic = sums.kinetic_energy(particles.mass, particles.velocity)
     scale = substeps.energy_scale(kinetic, total, TOTAL_ENERGY_FLOOR)
     energy = math.sqrt(field.stiffness(particles, vessel)) / scale if scale > 0.0 else 0.0
     return max(energy, field.rate(particles, vessel) ** 2)
@@ -468,40 +543,39 @@ def _newton(
 @dataclass(frozen=True, eq=False)
 class _SmoothFlight:
     """A scene's part in the compiled contact-free substeps (`collidium.kernels.substeps`): the
-    vessel and forces it was made for, copies of the masses, radii and the pair forces' sources
-    (the particles' properties ``names``), their couplings and squared softenings, and the walls
-    as the exact engine has them. The integrator keeps it while it `fits`: making it is most of
-    the Python work of a small scene's reporting interval."""
+    vessel and forces it was made for, copies of the masses, radii and the pair force's sources
+    (the particles' property ``name``), its coupling and squared softening, and the walls as the
+    exact engine has them. The integrator keeps it while it `fits`: making it is most of the
+    Python work of a small scene's reporting interval."""
 
     vessel: Vessel
     field: ForceField
-    names: tuple[str, ...]
+    name: str
     mass: FloatArray
     radius: FloatArray
-    sources: FloatArray
-    couplings: FloatArray
-    softening2: FloatArray
+    source: FloatArray
+    coupling: float
+    softening2: float
     walls: tuple[int, float, float, float, FloatArray]
 
     @classmethod
     def of(cls, particles: Particles, vessel: Vessel, field: ForceField) -> _SmoothFlight | None:
         """The scene's part, or None unless the vessel has walls (not periodic), the particles
-        are few enough for one thread (`PARALLEL_DIRECT_FROM`) and every force is a direct pair
-        sum (`ForceField.direct_terms`; a vessel with a piston has no such force). A substep
-        that meets no contact is a straight flight in every collision mode."""
+        are few enough for one thread (`PARALLEL_DIRECT_FROM`) and the one force is a direct
+        pair sum (`ForceField.direct_term`; a vessel with a piston has no such force). A
+        substep that meets no contact is a straight flight in every collision mode."""
         if vessel.periodic or particles.n >= PARALLEL_DIRECT_FROM:
             return None
-        terms = field.direct_terms(particles, vessel)
-        if terms is None:
+        term = field.direct_term(particles, vessel)
+        if term is None:
             return None
-        names, couplings, softening2 = terms
+        name, coupling, softening2 = term
         half_width, half_height = (0.5 * float(side) for side in vessel.extent)
         walls = (vessel.shape_code, half_width, half_height, vessel.rim, vessel.segments())
         # Contiguous copies: the particles' arrays may be edited in place (`fits` compares), and
-        # a shared mass or radius is a stride-0 view, which would compile the substeps again.
-        sources = np.stack([getattr(particles, name) for name in names])
-        return cls(vessel, field, names, np.array(particles.mass), np.array(particles.radius),
-                   sources, couplings, softening2, walls)  # fmt: skip
+        # a shared value is a stride-0 view, which would compile the substeps again.
+        return cls(vessel, field, name, np.array(particles.mass), np.array(particles.radius),
+                   np.array(getattr(particles, name)), coupling, softening2, walls)  # fmt: skip
 
     def fits(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
         """Whether this is still the scene's part: the same vessel and forces, and particles of
@@ -511,11 +585,32 @@ class _SmoothFlight:
             and field is self.field
             and np.array_equal(particles.mass, self.mass)
             and np.array_equal(particles.radius, self.radius)
-            and all(
-                np.array_equal(getattr(particles, name), row)
-                for name, row in zip(self.names, self.sources, strict=True)
-            )
+            and np.array_equal(getattr(particles, self.name), self.source)
         )
+
+    def intervals(
+        self,
+        particles: Particles,
+        field: ForceField,
+        origin: float,
+        elapsed: int,
+        dt: float,
+        starting: int,
+        tolerance: float,
+        kinetic: FloatArray,
+        potential: FloatArray,
+    ) -> tuple[int, int]:
+        """Whole intervals, up to ``len(kinetic)``, that meet no contact, the first taken with
+        ``starting`` substeps or more (`collidium.kernels.substeps.smooth_intervals`):
+        ``(intervals taken, the substep count the next starts from)``. The field's acceleration
+        is kept current."""
+        flown, after = substeps.smooth_intervals(
+            particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
+            self.source, self.coupling, self.softening2, *self.walls, origin, elapsed, dt,
+            kinetic.shape[0], starting, tolerance, MAX_SUBSTEPS, TOTAL_ENERGY_FLOOR, kinetic,
+            potential,
+        )  # fmt: skip
+        return int(flown), int(after)
 
     def squared_rate(self, particles: Particles, field: ForceField, total: float) -> float:
         """`_squared_rate` of the current state, compiled (the same to round-off)."""
@@ -540,9 +635,13 @@ class _SmoothFlight:
         is kept current; its energies are summed again when read."""
         return substeps.smooth_substeps(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
-            self.sources, self.couplings, self.softening2, *self.walls, now, dt, first, count, t,
+            self.source, self.coupling, self.softening2, *self.walls, now, dt, first, count, t,
             fastest, total, TOTAL_ENERGY_FLOOR,
         )  # fmt: skip
+
+
+#: The energies of a single compiled interval, not read (`AdaptiveLeapfrog._with_forces`).
+_ONE = np.empty(1)
 
 
 class _Snapshot:

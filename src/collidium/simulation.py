@@ -10,12 +10,18 @@ Run loop, one step of length dt (the reporting interval):
 2. ``time += dt``, ``steps += 1``;
 3. audit: a NaN/infinity or a particle outside the vessel stops the run with `SimulationError`;
 4. observers whose trigger fires (``trigger(sim)``) are updated.
+
+Where the integrator can (a small scene under direct pair forces: `Integrator.fly`), the steps
+before the next observer that reads the state are taken in one compiled call, bit for bit as one
+by one; observers that read the energies alone (`collidium.observers.EnergyDrift`) get those of
+each step from it.
 """
 
 from __future__ import annotations
 
 import copy
 import math
+import typing
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,6 +33,7 @@ from numpy.typing import ArrayLike
 from collidium.collisions import COLLISION_MODES, CollisionMode, Tally, make_drift
 from collidium.errors import InputError, SimulationError
 from collidium.forces import Force, ForceField, PositionForce, force_from_dict
+from collidium.forces.pair import writable
 from collidium.integrators import (
     DEFAULT_TOLERANCE,
     INTEGRATORS,
@@ -37,13 +44,18 @@ from collidium.integrators import (
 from collidium.io.checkpoint import read_checkpoint, saved_vessel, write_checkpoint
 from collidium.kernels.audit import first_invalid
 from collidium.kernels.cells import first_overlap, grid_shape, grid_window, window_sides
-from collidium.observers.base import Observer
+from collidium.kernels.sums import kinetic_energy
+from collidium.observers.base import Every, Observer
 from collidium.state import PROPERTIES, FloatArray, Particles, as_given
 from collidium.vessels import OUTSIDE_TOLERANCE, Vessel, vessel_from_dict
 from collidium.vessels.walls import check_restitution
 
 #: Most steps one `Simulation.run` call accepts (a guard against a mistyped time or dt).
 MAX_STEPS = 1e12
+
+#: Most steps the integrator flies in one compiled call (`Integrator.fly`): a Ctrl-C waits for
+#: the call to end, a fraction of a second for a small charged scene.
+MOST_FLOWN = 1000
 
 
 @dataclass(frozen=True)
@@ -384,14 +396,68 @@ class Simulation:
             with Progress(console=Console(stderr=True), transient=True) as bar:
                 task = bar.add_task(f"{self.name}", total=count)
                 stride = max(1, count // 200)
-                for k in range(count):
-                    self._step()
-                    if (k + 1) % stride == 0 or k + 1 == count:
-                        bar.update(task, completed=k + 1)
+                for done in range(0, count, stride):
+                    self._advance(min(stride, count - done))
+                    bar.update(task, completed=min(done + stride, count))
         else:
-            for _ in range(count):
-                self._step()
+            self._advance(count)
         return self
+
+    def _advance(self, count: int) -> None:
+        """Take ``count`` steps: one compiled call for each run of steps the integrator can fly
+        (`Integrator.fly`) before an observer reads the state, the others one by one."""
+        done = 0
+        while done < count:
+            run = self._run_length(count - done)
+            if run > 1:
+                flown = self._fly(run)
+                done += flown
+                if flown == run:
+                    continue
+            self._step()
+            done += 1
+
+    def _run_length(self, left: int) -> int:
+        """Steps, up to ``left`` and `MOST_FLOWN`, until an observer reads the state: one unless
+        the integrator can fly here and every trigger is an `Every`. Those that read the
+        energies alone (``take_energies``) do not count: they get the flown steps' energies."""
+        run = min(left, MOST_FLOWN)
+        for observer in self.observers:
+            trigger = observer.trigger
+            if not isinstance(trigger, Every):
+                return 1
+            if not hasattr(observer, "take_energies"):
+                run = min(run, trigger.period - self.steps % trigger.period)
+        if run > 1 and not self._integrator.flies(self.particles, self.container, self._field):
+            return 1
+        return run
+
+    def _fly(self, run: int) -> int:
+        """Up to ``run`` steps in one compiled call; the observers that read the energies get
+        those of the steps on which they fire, and after the last step, if it was taken, the
+        others fire as after any step. Returns the steps taken."""
+        kinetic, potential = np.empty(run), np.empty(run)
+        first = self.steps
+        origin, start = self._time_origin
+        flown = self._integrator.fly(
+            self.particles, self.container, self._field, origin, first - start, self.dt, kinetic,
+            potential,
+        )  # fmt: skip
+        if flown == 0:
+            return 0
+        self.steps += flown
+        self._audit()
+        fired = np.arange(first + 1, self.steps + 1)
+        for observer in self.observers:
+            if hasattr(observer, "take_energies"):
+                at = fired % typing.cast(Every, observer.trigger).period == 0
+                if at.any():
+                    observer.take_energies(self, kinetic[:flown][at], potential[:flown][at])
+        if flown == run:
+            for observer in self.observers:
+                if not hasattr(observer, "take_energies") and observer.trigger(self):
+                    observer.update(self)
+        return flown
 
     def _step(self) -> None:
         try:
@@ -434,8 +500,8 @@ class Simulation:
         return Energy(self._kinetic(), self._field.potential(self.particles, self.container))
 
     def _kinetic(self) -> float:
-        p = self.particles
-        return 0.5 * float(np.sum(p.mass * np.einsum("ij,ij->i", p.velocity, p.velocity)))
+        # In particle order, as the compiled intervals sum it (`collidium.kernels.sums`).
+        return float(kinetic_energy(writable(self.particles.mass), self.particles.velocity))
 
     def temperature(self) -> float:
         """kT = KE / N in J (2 degrees of freedom per particle, Boltzmann's constant 1); NaN

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 from collidium import Polygon
 from collidium.kernels import reference
-from collidium.kernels.substeps import CONTACT_MARGIN, kinetic_energy, smooth_substeps
+from collidium.kernels.substeps import CONTACT_MARGIN, needed, smooth_intervals, smooth_substeps
+from collidium.kernels.sums import kinetic_energy
 from collidium.kernels.vessels import BOX, CIRCLE, POLYGON
 
 FLOOR = 10.0
@@ -16,8 +19,8 @@ HEXAGON = Polygon([[6.0 * np.cos(a), 6.0 * np.sin(a)] for a in np.arange(6) * np
 
 
 def scene(rng, n, spread=3.0, speed=1.0):
-    """Disks of radius 0.1 on a jittered ring (none touching), random masses, charges of both
-    signs as the first force's sources and the masses as a second's (Newton's, G = 0.5)."""
+    """Disks of radius 0.1 on a jittered ring (none touching), random masses and charges of both
+    signs (some neutral), with k = 5 and a softening of 0.1 m."""
     angle = np.arange(n) * 2 * np.pi / n
     position = spread * np.column_stack([np.cos(angle), np.sin(angle)])
     position += rng.uniform(-0.2, 0.2, position.shape)
@@ -25,23 +28,17 @@ def scene(rng, n, spread=3.0, speed=1.0):
     mass = rng.uniform(0.5, 2.0, n)
     radius = np.full(n, 0.1)
     charge = rng.choice([-1.0, 0.0, 1.0], n)
-    sources = np.ascontiguousarray(np.stack([charge, mass]))
-    return position, velocity, mass, radius, sources, np.array([5.0, -0.5]), np.array([0.01, 0.0])
+    return position, velocity, mass, radius, charge, 5.0, 0.01
 
 
-def accelerations(position, mass, sources, couplings, softening2):
-    force = sum(
-        reference.inverse_distance_direct(position, q, c, e)[0]
-        for q, c, e in zip(sources, couplings, softening2, strict=True)
+def accelerations(position, mass, source, coupling, softening2):
+    return (
+        reference.inverse_distance_direct(position, source, coupling, softening2)[0] / mass[:, None]
     )
-    return force / mass[:, None]
 
 
-def energy(position, sources, couplings, softening2):
-    return sum(
-        float(reference.inverse_distance_direct(position, q, c, e)[1].sum())
-        for q, c, e in zip(sources, couplings, softening2, strict=True)
-    )
+def energy(position, source, coupling, softening2):
+    return float(reference.inverse_distance_direct(position, source, coupling, softening2)[1].sum())
 
 
 WALLS = {
@@ -57,15 +54,15 @@ def test_substeps_equal_their_twin(rng, vessel, speed):
     """Slow disks take every substep of 0.1 s; fast ones, 4 m in it, stop where the twin
     stops, at a wall or a pair."""
     shape, half, rim, table = WALLS[vessel]
-    position, velocity, mass, radius, sources, couplings, softening2 = scene(rng, 12, speed=speed)
-    acceleration = accelerations(position, mass, sources, couplings, softening2)
-    total = kinetic_energy(mass, velocity) + energy(position, sources, couplings, softening2)
+    position, velocity, mass, radius, source, coupling, softening2 = scene(rng, 12, speed=speed)
+    acceleration = accelerations(position, mass, source, coupling, softening2)
+    total = kinetic_energy(mass, velocity) + energy(position, source, coupling, softening2)
     got = [a.copy() for a in (position, velocity, acceleration)]
     want = [a.copy() for a in (position, velocity, acceleration)]
-    step, t, fastest = smooth_substeps(*got, mass, radius, sources, couplings, softening2, shape,
+    step, t, fastest = smooth_substeps(*got, mass, radius, source, coupling, softening2, shape,
                                        half[0], half[1], rim, table, 1.0, 0.1, 1, 16, 1.0, 0.0,
                                        total, FLOOR)  # fmt: skip
-    twin = reference.smooth_substeps(*want, mass, radius, sources, couplings, softening2, shape,
+    twin = reference.smooth_substeps(*want, mass, radius, source, coupling, softening2, shape,
                                      half, rim, table, 1.0, 0.1, 1, 16, 1.0, 0.0, total, FLOOR,
                                      CONTACT_MARGIN)  # fmt: skip
     assert (step, t) == twin[:2]
@@ -88,8 +85,7 @@ def test_a_crowd_stops_where_its_all_pairs_twin_stops(rng):
         position = grid + rng.uniform(-0.2, 0.2, grid.shape)  # gaps of 0.1 m at least
         radius = rng.uniform(0.05, 0.3, n)
         velocity = rng.normal(0.0, 1.0, (n, 2))
-        args = (np.zeros((n, 2)), np.ones(n), radius, np.zeros((1, n)), np.array([5.0]),
-                np.zeros(1), BOX)  # fmt: skip
+        args = (np.zeros((n, 2)), np.ones(n), radius, np.zeros(n), 5.0, 0.0, BOX)
         got, want = (position.copy(), velocity.copy()), (position.copy(), velocity.copy())
         step, t, _ = smooth_substeps(*got, *args, 20.0, 20.0, np.nan, NONE, 0.0, 2.0, 1, 64, 0.0,
                                      0.0, 1.0, FLOOR)  # fmt: skip
@@ -110,10 +106,9 @@ def test_a_disk_bound_for_a_wall_stops_the_substeps_just_before_it():
     velocity = np.array([[10.0, 0.0], [0.0, 0.0]])
     acceleration = np.zeros((2, 2))
     mass, radius = np.ones(2), np.array([0.1, 0.1])
-    sources = np.zeros((1, 2))
-    step, t, _ = smooth_substeps(position, velocity, acceleration, mass, radius, sources,
-                                 np.array([5.0]), np.zeros(1), BOX, 5.0, 5.0, np.nan, NONE, 0.0,
-                                 0.16, 1, 16, 0.0, 0.0, 50.0, FLOOR)  # fmt: skip
+    step, t, _ = smooth_substeps(position, velocity, acceleration, mass, radius, np.zeros(2), 5.0,
+                                 0.0, BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.16, 1, 16, 0.0, 0.0,
+                                 50.0, FLOOR)  # fmt: skip
     # The wall's contact is at x = 4.9, 0.1 s on: substeps 1 to 9 end at 0.09 s.
     assert (step, t) == (10, pytest.approx(0.09, rel=1e-15))
     np.testing.assert_allclose(position[0], [3.9 + 0.9, 0.0], rtol=1e-14)
@@ -127,9 +122,8 @@ def test_a_grazing_pair_stops_the_substeps_within_the_margin(miss):
     sigma = 0.2
     position = np.array([[-1.0, 0.5 * sigma * (1 + miss)], [1.0, -0.5 * sigma * (1 + miss)]])
     velocity = np.array([[5.0, 0.0], [-5.0, 0.0]])
-    args = (np.zeros((2, 2)), np.ones(2), np.full(2, 0.5 * sigma), np.zeros((1, 2)),
-            np.array([5.0]), np.zeros(1), BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.4, 1, 4, 0.0, 0.0,
-            25.0, FLOOR)  # fmt: skip
+    args = (np.zeros((2, 2)), np.ones(2), np.full(2, 0.5 * sigma), np.zeros(2), 5.0, 0.0, BOX,
+            5.0, 5.0, np.nan, NONE, 0.0, 0.4, 1, 4, 0.0, 0.0, 25.0, FLOOR)  # fmt: skip
     step, _, _ = smooth_substeps(position, velocity, *args)
     assert step == (5 if miss > CONTACT_MARGIN else 2)  # they meet in the second 0.1 s
 
@@ -142,9 +136,8 @@ def test_infinite_accelerations_stop_the_substeps_with_nothing_changed():
     acceleration = np.zeros((2, 2))
     before = position.copy()
     step, t, fastest = smooth_substeps(position, velocity, acceleration, np.array([1e-310, 1.0]),
-                                       np.zeros(2), np.ones((1, 2)), np.array([5.0]), np.zeros(1),
-                                       BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.1, 1, 4, 0.0, 0.0,
-                                       2.5, FLOOR)  # fmt: skip
+                                       np.zeros(2), np.ones(2), 5.0, 0.0, BOX, 5.0, 5.0, np.nan,
+                                       NONE, 0.0, 0.1, 1, 4, 0.0, 0.0, 2.5, FLOOR)  # fmt: skip
     assert (step, t, fastest) == (1, 0.0, 0.0)
     np.testing.assert_array_equal(position, before)
     np.testing.assert_array_equal(velocity, 0.0)
@@ -155,3 +148,84 @@ def test_kinetic_energy_is_half_m_v_squared(rng):
     velocity = rng.normal(0.0, 3.0, (50, 2))
     want = 0.5 * np.sum(mass * np.sum(velocity**2, axis=1))
     assert kinetic_energy(mass, velocity) == pytest.approx(want, rel=1e-14)
+
+
+TOLERANCE = 0.01
+MOST = 2**14
+
+
+def three_bodies():
+    """A heavy +2 C at the centre of a 10 m box, two light -1 C circling it at 1 and 2 m, with
+    k = 5: their orbits stay clear of each other and of the walls."""
+    position = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, -2.0]])
+    velocity = np.array([[0.0, 0.0], [0.0, 3.1], [2.2, 0.0]])
+    mass = np.array([100.0, 1.0, 1.0])
+    charge = np.array([2.0, -1.0, -1.0])
+    return position, velocity, mass, np.full(3, 0.05), charge
+
+
+@pytest.mark.parametrize("count", [1, 40])
+def test_intervals_equal_their_twin(count):
+    """Intervals of 0.05 s of two light charges circling a heavy one: the same intervals taken,
+    substep counts and energies as the twin's, the motion to round-off."""
+    position, velocity, mass, radius, charge = three_bodies()
+    acceleration = accelerations(position, mass, charge, 5.0, 0.0)
+    got = [a.copy() for a in (position, velocity, acceleration)]
+    want = [a.copy() for a in (position, velocity, acceleration)]
+    kinetic, potential = np.empty(count), np.empty(count)
+    flown, after = smooth_intervals(*got, mass, radius, charge, 5.0, 0.0, BOX, 5.0, 5.0, np.nan,
+                                    NONE, 0.0, 0, 0.05, count, 1, TOLERANCE, MOST, FLOOR, kinetic,
+                                    potential)  # fmt: skip
+    twin = reference.smooth_intervals(*want, mass, radius, charge, 5.0, 0.0, BOX,
+                                      np.array([5.0, 5.0]), np.nan, NONE, 0.0, 0, 0.05, count, 1,
+                                      TOLERANCE, MOST, FLOOR, CONTACT_MARGIN)  # fmt: skip
+    assert (flown, after) == (count, twin[1]) and twin[0] == count
+    assert after >= 8  # the inner orbit needs substeps
+    np.testing.assert_allclose(kinetic, twin[2], rtol=1e-11)
+    np.testing.assert_allclose(potential, twin[3], rtol=1e-11)
+    for ours, theirs in zip(got, want, strict=True):
+        np.testing.assert_allclose(ours, theirs, rtol=1e-10, atol=1e-12)
+
+
+def test_an_interval_that_meets_a_wall_is_left_as_it_began():
+    """The outer charge flung at a wall: the intervals before the one that meets it are taken,
+    that one is put back bit for bit (the state the intervals before left), and the substep
+    count is that of the last interval taken."""
+    position, velocity, mass, radius, charge = three_bodies()
+    velocity[2] = [0.0, -20.0]  # 3 m from the wall: in the fourth interval of 0.05 s
+    acceleration = accelerations(position, mass, charge, 5.0, 0.0)
+    state = [a.copy() for a in (position, velocity, acceleration)]
+    energies = np.empty(10), np.empty(10)
+    flown, after = smooth_intervals(*state, mass, radius, charge, 5.0, 0.0, BOX, 5.0, 5.0, np.nan,
+                                    NONE, 0.0, 0, 0.05, 10, 1, TOLERANCE, MOST, FLOOR,
+                                    *energies)  # fmt: skip
+    assert 1 <= flown <= 3
+    before = [a.copy() for a in (position, velocity, acceleration)]
+    _, want = smooth_intervals(*before, mass, radius, charge, 5.0, 0.0, BOX, 5.0, 5.0, np.nan,
+                               NONE, 0.0, 0, 0.05, flown, 1, TOLERANCE, MOST, FLOOR,
+                               *energies)  # fmt: skip
+    assert after == want
+    for ours, theirs in zip(state, before, strict=True):
+        np.testing.assert_array_equal(ours, theirs)
+
+
+def test_intervals_that_need_too_many_substeps_are_left_to_the_integrator():
+    """Charges 1 mm apart at rest: the first interval needs more substeps than the most, and
+    nothing is taken (the integrator then stops the run with its message)."""
+    position = np.array([[0.0, 0.0], [0.001, 0.0]])
+    state = [position, np.zeros((2, 2)), np.zeros((2, 2))]
+    flown, after = smooth_intervals(*state, np.ones(2), np.zeros(2), np.array([1.0, -1.0]), 5.0,
+                                    0.0, BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0, 1.0, 4, 2, 1e-4, 16,
+                                    FLOOR, np.empty(4), np.empty(4))  # fmt: skip
+    assert (flown, after) == (0, 2)
+    np.testing.assert_array_equal(state[0], [[0.0, 0.0], [0.001, 0.0]])
+
+
+@pytest.mark.parametrize("ratio", [0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 1000.0, 1024.0, 1025.0, 2e9])
+def test_needed_is_the_smallest_power_of_two_that_keeps_the_substep_within_the_tolerance(ratio):
+    """``dt sqrt(rate2) / tolerance`` = ``ratio`` substeps' worth: the next power of two, exact
+    powers kept, capped at the most."""
+    rate2 = (ratio * 0.001 / 0.01) ** 2
+    assert needed(rate2, 0.01, 0.001, MOST) == reference.needed(rate2, 0.01, 0.001, MOST)
+    assert needed(rate2, 0.01, 0.001, MOST) == min(MOST, max(1, 2 ** math.ceil(math.log2(ratio))))
+    assert needed(np.nan, 0.01, 0.001, MOST) == MOST

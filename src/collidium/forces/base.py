@@ -18,6 +18,7 @@ from typing import Any, ClassVar, Protocol, TypeVar, runtime_checkable
 import numpy as np
 
 from collidium.errors import InputError, SimulationError
+from collidium.kernels.sums import ordered_sum
 from collidium.state import FloatArray, Particles
 from collidium.vessels import Vessel
 
@@ -325,9 +326,9 @@ class ForceField:
                               energies)  # fmt: skip
                 if not carried:
                     self._acceleration += self._force
-                if energies:
-                    potential += float(np.sum(self._energy))
-                    virial += float(np.sum(self._virial))
+                if energies:  # in particle order, as the compiled intervals sum them
+                    potential += ordered_sum(self._energy)
+                    virial += ordered_sum(self._virial)
             np.divide(self._acceleration, particles.mass[:, None], out=self._acceleration)
         _refuse_infinite(self._acceleration)
         self._potential = potential
@@ -336,23 +337,14 @@ class ForceField:
         self._evaluated_at = particles.position.copy()
         return self._acceleration
 
-    def direct_terms(
-        self, particles: Particles, vessel: Vessel
-    ) -> tuple[tuple[str, ...], FloatArray, FloatArray] | None:
-        """The forces as the compiled substeps sum them (`collidium.kernels.substeps`): the
-        particles' properties that hold their sources (F names), couplings (F,) and squared
-        softenings (F,) m^2, when every force is a direct inverse-distance pair sum
+    def direct_term(self, particles: Particles, vessel: Vessel) -> tuple[str, float, float] | None:
+        """The force as the compiled substeps sum it (`collidium.kernels.substeps`): the
+        particles' property that holds its sources, its coupling and its squared softening (m^2),
+        when the field's one force is a direct inverse-distance pair sum
         (`DirectPairForce.direct_term`); None otherwise."""
-        if self._velocity or not self._position or not self._direct:
+        if self._velocity or len(self._position) != 1 or not self._direct:
             return None
-        terms = []
-        for force in self._position:
-            term = typing.cast(DirectPairForce, force).direct_term(particles, vessel)
-            if term is None:
-                return None
-            terms.append(term)
-        sources, couplings, softening2 = zip(*terms, strict=True)
-        return sources, np.array(couplings), np.array(softening2)
+        return typing.cast(DirectPairForce, self._position[0]).direct_term(particles, vessel)
 
     def stiffness(self, particles: Particles, vessel: Vessel) -> float:
         """``S`` of all forces at the current state, in J^2/s^4: the largest of the forces'

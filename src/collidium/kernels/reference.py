@@ -807,9 +807,9 @@ def smooth_substeps(
     acceleration: FloatArray,
     mass: FloatArray,
     radius: FloatArray,
-    sources: FloatArray,
-    couplings: FloatArray,
-    softening2: FloatArray,
+    source: FloatArray,
+    coupling: float,
+    softening2: float,
     shape: int,
     half: FloatArray,
     rim: float,
@@ -828,12 +828,14 @@ def smooth_substeps(
     circle of radius ``rim`` (`CIRCLE`) or neither, and against the segments of ``table``.
 
     Each substep: the kick; the contact test on all pairs and walls at once (contacts within
-    ``margin`` of a radius, or of the substep); the straight flight; the forces
-    (`inverse_distance_direct`); the squared rate from the ``total`` energy (the potential taken
-    as the total less the kinetic) and `inverse_distance_stiffness`. Updates the motion in place
-    and returns ``(substep not taken, its start, fastest)``.
+    ``margin`` of a radius, or of the substep); the straight flight; the force
+    (`inverse_distance_direct`); the squared rate from the ``total`` energy (`squared_rate`).
+    Updates the motion in place and returns ``(substep not taken, its start, fastest)``.
     """
     zero = np.zeros(2)
+    if fastest < 0.0:
+        fastest = squared_rate(position, velocity, mass, source, coupling, softening2, total,
+                               energy_floor)  # fmt: skip
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
@@ -856,22 +858,110 @@ def smooth_substeps(
         if not np.isfinite(kicked).all() or wall <= h * (1.0 + margin) or np.triu(meets, 1).any():
             return s, t, fastest
         flown = position + kicked * h
-        force = np.zeros_like(position)
-        for source, coupling, eps2 in zip(sources, couplings, softening2, strict=True):
-            force += inverse_distance_direct(flown, source, coupling, eps2)[0]
-        pull = force / mass[:, None]
+        pull = inverse_distance_direct(flown, source, coupling, softening2)[0] / mass[:, None]
         if not np.isfinite(pull).all():
             return s, t, fastest
         position[...] = flown
         velocity[...] = kicked + 0.5 * h * pull
         acceleration[...] = pull
         t = end
-        stiffness = max(
-            inverse_distance_stiffness(position, velocity, source, mass, coupling, eps2)
-            for source, coupling, eps2 in zip(sources, couplings, softening2, strict=True)
-        )
-        kinetic = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1)))
-        potential = total - kinetic
-        scale = max(abs(total), (kinetic + abs(potential)) / energy_floor)
-        fastest = max(fastest, math.sqrt(stiffness) / scale if scale > 0.0 else 0.0)
+        rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, total,
+                             energy_floor)  # fmt: skip
+        fastest = max(fastest, rate2)
     return count + 1, t, fastest
+
+
+def squared_rate(
+    position: FloatArray,
+    velocity: FloatArray,
+    mass: FloatArray,
+    source: FloatArray,
+    coupling: float,
+    softening2: float,
+    total: float,
+    energy_floor: float,
+) -> float:
+    """Twin of the substeps' rate: the square root of the stiffness
+    (`inverse_distance_stiffness`) over the energy scale, ``|E|`` (``total``) but at least
+    ``(KE + |U|) / energy_floor`` with ``U = E - KE``."""
+    stiffness = inverse_distance_stiffness(position, velocity, source, mass, coupling, softening2)
+    kinetic = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1)))
+    scale = max(abs(total), (kinetic + abs(total - kinetic)) / energy_floor)
+    return math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
+
+
+def needed(rate2: float, dt: float, tolerance: float, most: int) -> int:
+    """Twin of `substeps.needed`: the smallest power of two n >= ``dt sqrt(rate2) /
+    tolerance``, at most ``most``."""
+    ratio = dt * math.sqrt(rate2) / tolerance
+    if not ratio <= most:
+        return most
+    return 1 if ratio <= 1.0 else 2 ** math.ceil(math.log2(ratio))
+
+
+def smooth_intervals(
+    position: FloatArray,
+    velocity: FloatArray,
+    acceleration: FloatArray,
+    mass: FloatArray,
+    radius: FloatArray,
+    source: FloatArray,
+    coupling: float,
+    softening2: float,
+    shape: int,
+    half: FloatArray,
+    rim: float,
+    table: FloatArray,
+    origin: float,
+    elapsed: int,
+    dt: float,
+    count: int,
+    substeps: int,
+    tolerance: float,
+    most: int,
+    energy_floor: float,
+    margin: float,
+) -> tuple[int, int, list[float], list[float]]:
+    """Twin of `substeps.smooth_intervals`: interval by interval, the substep count from the
+    rate at its start (`needed`), `smooth_substeps` from its first substep, taken again with
+    more substeps while a boundary needs more; the first interval that meets a contact is put
+    back as it began. Returns ``(intervals taken, the next count, kinetic and potential
+    energies after each)``."""
+    kinetic: list[float] = []
+    potential: list[float] = []
+
+    def energies() -> tuple[float, float]:
+        moving = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1)))
+        pairs = float(inverse_distance_direct(position, source, coupling, softening2)[1].sum())
+        return moving, pairs
+
+    for k in range(count):
+        now = origin + (elapsed + k) * dt
+        total = sum(energies())
+        rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, total,
+                             energy_floor)  # fmt: skip
+        if not dt * math.sqrt(rate2) <= most * tolerance:
+            return k, substeps, kinetic, potential
+        taken = max(substeps, needed(rate2, dt, tolerance, most))
+        start = [a.copy() for a in (position, velocity, acceleration)]
+        while True:
+            reached, _, fastest = smooth_substeps(
+                position, velocity, acceleration, mass, radius, source, coupling, softening2,
+                shape, half, rim, table, now, dt, 1, taken, now, rate2, total, energy_floor,
+                margin,
+            )  # fmt: skip
+            met = reached <= taken
+            required = needed(fastest, dt, tolerance, most)
+            if met or required > taken:
+                for array, kept in zip((position, velocity, acceleration), start, strict=True):
+                    array[...] = kept
+            if met:
+                return k, substeps, kinetic, potential
+            if required <= taken:
+                break
+            taken = max(required, 2 * taken)
+        substeps = max(1, taken // 2) if required <= taken // 2 else taken
+        moving, pairs = energies()
+        kinetic.append(moving)
+        potential.append(pairs)
+    return count, substeps, kinetic, potential

@@ -4,7 +4,8 @@ The adaptive integrator (`collidium.integrators.AdaptiveLeapfrog`) cuts a report
 into n equal kick-drift-kick substeps. In a small charged scene most substeps meet no contact,
 and their drift is then a straight flight; a Python call per substep (kick, drift, force sum,
 substep rate) costs a hundred times the arithmetic. `smooth_substeps` flies a run of such
-substeps in one call, with the pair sums of `collidium.kernels.pairwise`, and stops before the
+substeps under one inverse-distance pair force (every seed scene has one; two take the Python
+path) in one call, with the pair sums of `collidium.kernels.pairwise`, and stops before the
 first substep whose flight would bring a disk near a wall or another disk, or whose values stop
 being finite: the integrator takes that one in Python, where the collision modes and the error
 messages are (the divisions here follow NumPy: an overflow gives inf, which stops the
@@ -21,6 +22,7 @@ import numpy as np
 
 from collidium.kernels.pairwise import MOST_BLOCKS, larger, pair_sums, stiffness_row
 from collidium.kernels.sorting import sort_nearly_sorted
+from collidium.kernels.sums import kinetic_energy
 from collidium.kernels.vessels import contacts
 
 #: Relative margin of the contact test: a disk that comes within this fraction of its radius (or
@@ -28,16 +30,6 @@ from collidium.kernels.vessels import contacts
 #: meeting it. The engine finds contacts from the same numbers but at other instants (after a
 #: cell crossing), so round-off could otherwise part the two on a grazing contact.
 CONTACT_MARGIN = 1e-6
-
-
-@numba.njit(cache=True)
-def kinetic_energy(mass: np.ndarray, velocity: np.ndarray) -> float:
-    """``sum m v^2 / 2`` in J of masses (N,) in kg and velocities (N, 2) in m/s, summed in
-    particle order (the substep rate's, alike in both paths of the integrator)."""
-    total = 0.0
-    for i in range(mass.shape[0]):
-        total += mass[i] * (velocity[i, 0] * velocity[i, 0] + velocity[i, 1] * velocity[i, 1])
-    return 0.5 * total
 
 
 @numba.njit(cache=True)
@@ -50,7 +42,7 @@ def energy_scale(kinetic: float, total: float, floor: float) -> float:
 
 @numba.njit(cache=True, error_model="numpy")
 def smooth_substeps(
-    position, velocity, acceleration, mass, radius, sources, couplings, softening2,
+    position, velocity, acceleration, mass, radius, source, coupling, softening2,
     shape, half_width, half_height, rim, segments, now, dt, first, count, t, fastest, total,
     energy_floor,
 ) -> tuple[int, float, float]:  # fmt: skip
@@ -69,10 +61,10 @@ def smooth_substeps(
         In m, m/s and m/s^2, at time ``t``, which is substep ``first``'s start; updated.
     mass, radius : ndarray, shape (N,)
         In kg and m.
-    sources : ndarray, shape (F, N)
-        Each pair force's sources (`collidium.kernels.pairwise.inverse_distance_direct`).
-    couplings, softening2 : ndarray, shape (F,)
-        Each pair force's coupling (N m^2 per source squared) and squared softening (m^2).
+    source : ndarray, shape (N,)
+        The pair force's sources (`collidium.kernels.pairwise.inverse_distance_direct`).
+    coupling, softening2 : float
+        Its coupling (N m^2 per source squared) and squared softening (m^2).
     shape, half_width, half_height, rim, segments
         The vessel as the exact engine has it (`collidium.kernels.vessels.contacts.earliest`).
     now, dt : float
@@ -96,33 +88,157 @@ def smooth_substeps(
         ``(substep, time, fastest)``: the substep not taken (``count + 1`` when all were), its
         start (s) and the largest squared rate.
     """
-    n = position.shape[0]
-    kicked = np.empty((n, 2))
-    flown = np.empty((n, 2))
-    pull = np.empty((n, 2))
-    # Each force's particles with a source, in a row of (index, source, 1 / mass), and work
-    # rows for their coordinates and velocities: the pair rows read contiguous arrays.
-    index, charged, inverse_mass, counts = _with_sources(sources, mass)
-    moving = np.empty((4, n))
-    sums = np.empty(4 * n * (1 + MOST_BLOCKS // 2))  # the pair sums' work (`_accelerations`)
-    order, low, high = np.arange(n), np.empty(n), np.empty(n)  # the sweep (`_meets_contact`)
+    work = _work(mass, source)
     walls = (shape, half_width, half_height, rim, segments)
+    return _substeps(position, velocity, acceleration, mass, radius, coupling, softening2, walls,
+                     now, dt, first, count, t, fastest, total, energy_floor, work)  # fmt: skip
+
+
+@numba.njit(cache=True, error_model="numpy")
+def smooth_intervals(
+    position, velocity, acceleration, mass, radius, source, coupling, softening2,
+    shape, half_width, half_height, rim, segments, origin, elapsed, dt, count, substeps,
+    tolerance, most_substeps, energy_floor, kinetic, potential,
+) -> tuple[int, int]:  # fmt: skip
+    """Up to ``count`` whole reporting intervals of ``dt`` (s), in place, each as the adaptive
+    integrator takes one (`collidium.integrators.AdaptiveLeapfrog`), up to the first that meets
+    a contact or a value that is not finite, or needs more than ``most_substeps``: that one is
+    left as it began, for the integrator.
+
+    Interval k starts at ``origin + (elapsed + k) dt``, the simulation's clock. Its substep count
+    is the larger of ``substeps`` and the fewest the rate at its start needs (`needed`); it is
+    taken again with more if a substep boundary needs more, and the count the next interval
+    starts from is this one, or half of it when half would have done.
+
+    Parameters
+    ----------
+    position, velocity, acceleration, mass, radius, source, coupling, softening2, shape,
+    half_width, half_height, rim, segments
+        As in `smooth_substeps`.
+    origin : float
+        The clock's origin, s.
+    elapsed : int
+        Steps from the clock's origin to the first interval's start.
+    dt : float
+        The reporting interval, s.
+    count : int
+        Most intervals to take.
+    substeps : int
+        The substep count the first interval starts from.
+    tolerance : float
+        The integrator's accuracy parameter (`needed`).
+    most_substeps : int
+        Most substeps in an interval (a power of two).
+    energy_floor : float
+        As in `smooth_substeps`.
+    kinetic, potential : ndarray, shape (count,)
+        Output: the kinetic and potential energy (J) at each interval's end, summed as
+        `collidium.simulation.Simulation.energy` sums them (`collidium.kernels.sums`).
+
+    Returns
+    -------
+    tuple of int
+        ``(intervals taken, the substep count the next interval starts from)``.
+    """
+    n = position.shape[0]
+    work = _work(mass, source)
+    walls = (shape, half_width, half_height, rim, segments)
+    start = np.empty((3, n, 2))
+    sources = work[3:12]
+    energy = _potential(position, coupling, softening2, sources)
+    for k in range(count):
+        now = origin + (elapsed + k) * dt
+        total = kinetic_energy(mass, velocity) + energy
+        rate2 = _squared_rate(position, velocity, mass, coupling, softening2, total, energy_floor,
+                              sources)  # fmt: skip
+        if not dt * math.sqrt(rate2) <= most_substeps * tolerance:  # also NaN
+            return k, substeps
+        taken = max(substeps, needed(rate2, dt, tolerance, most_substeps))
+        _keep(position, velocity, acceleration, start)
+        while True:
+            s, _, fastest = _substeps(position, velocity, acceleration, mass, radius, coupling,
+                                      softening2, walls, now, dt, 1, taken, now, rate2, total,
+                                      energy_floor, work)  # fmt: skip
+            if s <= taken:  # a contact, or a value not finite
+                _restore(position, velocity, acceleration, start)
+                return k, substeps
+            required = needed(fastest, dt, tolerance, most_substeps)
+            if required <= taken:
+                break
+            _restore(position, velocity, acceleration, start)
+            taken = max(required, 2 * taken)
+        substeps = max(1, taken // 2) if required <= taken // 2 else taken
+        energy = _potential(position, coupling, softening2, sources)
+        kinetic[k] = kinetic_energy(mass, velocity)
+        potential[k] = energy
+    return count, substeps
+
+
+@numba.njit(cache=True)
+def needed(rate2: float, dt: float, tolerance: float, most: int) -> int:
+    """The fewest substeps, a power of two up to ``most``, that keep ``dt / n`` (s) within
+    ``tolerance`` times the time scale ``1 / sqrt(rate2)`` (``rate2`` in 1/s^2)."""
+    ratio = dt * math.sqrt(rate2) / tolerance
+    if not ratio <= most:  # also NaN
+        return most
+    if ratio <= 1.0:
+        return 1
+    mantissa, exponent = math.frexp(ratio)  # ratio = mantissa 2^exponent, exactly
+    return 1 << (exponent - 1 if mantissa == 0.5 else exponent)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _work(mass, source):
+    """What `_substeps` works in, for N particles of which m have a source: kicked, flown and
+    pulled motions (N, 2); the indices, sources and inverse masses of those m; rows for their
+    coordinates and velocities (m,) each, their pair sums (4, m) and the sums' buffer; the
+    sweep's order and interval ends (N,) (`_meets_contact`). Arrays of their own, not views,
+    which cost a three-body substep more than its arithmetic."""
+    n = mass.shape[0]
+    m = 0
+    for i in range(n):
+        if source[i] != 0.0:
+            m += 1
+    index = np.empty(m, dtype=np.int64)
+    charged, inverse_mass = np.empty(m), np.empty(m)
+    c = 0
+    for i in range(n):
+        if source[i] != 0.0:
+            index[c], charged[c], inverse_mass[c] = i, source[i], 1.0 / mass[i]
+            c += 1
+    motion = (np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 2)))
+    rows = (np.empty(m), np.empty(m), np.empty(m), np.empty(m))
+    sums = (np.empty((4, m)), np.empty(4 * m * (MOST_BLOCKS // 2)))
+    sweep = (np.arange(n), np.empty(n), np.empty(n))
+    # Concatenated: numba builds an unpacked (*a, *b) through a list, which holds one type.
+    return motion + (index, charged, inverse_mass) + rows + sums + sweep  # noqa: RUF005
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _substeps(position, velocity, acceleration, mass, radius, coupling, softening2, walls, now,
+              dt, first, count, t, fastest, total, energy_floor, work):  # fmt: skip
+    """`smooth_substeps` in its work arrays (`_work`), the vessel as one tuple."""
+    kicked, flown, pull = work[:3]
+    index, charged, inverse_mass, x, y, vx, vy, sums, buffer = work[3:12]
+    order, low, high = work[12:]
+    n = position.shape[0]
     if fastest < 0.0:
-        fastest = _squared_rate(position, velocity, mass, index, charged, inverse_mass, counts,
-                                couplings, softening2, moving, total, energy_floor)  # fmt: skip
+        fastest = _squared_rate(position, velocity, mass, coupling, softening2, total,
+                                energy_floor, work[3:12])  # fmt: skip
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
         for i in range(n):
             for d in range(2):
                 kicked[i, d] = velocity[i, d] + (0.5 * h) * acceleration[i, d]
-        if not _finite(kicked) or _meets_contact(position, kicked, radius, h, *walls, order, low,
+        if not _finite(kicked) or _meets_contact(position, kicked, radius, h, walls, order, low,
                                                  high):  # fmt: skip
             return s, t, fastest
         for i in range(n):
             for d in range(2):
                 flown[i, d] = position[i, d] + kicked[i, d] * h
-        _accelerations(flown, mass, index, charged, counts, couplings, softening2, moving, sums,
+        # The arrays one by one: a tuple of them passed on costs a reference count each.
+        _accelerations(flown, mass, coupling, softening2, index, charged, x, y, sums, buffer,
                        pull)  # fmt: skip
         if not _finite(pull):
             return s, t, fastest
@@ -132,14 +248,34 @@ def smooth_substeps(
                 velocity[i, d] = kicked[i, d] + (0.5 * h) * pull[i, d]
                 acceleration[i, d] = pull[i, d]
         t = end
-        rate2 = _squared_rate(position, velocity, mass, index, charged, inverse_mass, counts,
-                              couplings, softening2, moving, total, energy_floor)  # fmt: skip
+        rate2 = _rate(position, velocity, mass, coupling, softening2, total, energy_floor, index,
+                      charged, inverse_mass, x, y, vx, vy)  # fmt: skip
         if rate2 > fastest:
             fastest = rate2
     return count + 1, t, fastest
 
 
 @numba.njit(cache=True)
+def _keep(position, velocity, acceleration, start) -> None:
+    """The motion into ``start`` (3, N, 2), to take an interval again."""
+    for i in range(position.shape[0]):
+        for d in range(2):
+            start[0, i, d] = position[i, d]
+            start[1, i, d] = velocity[i, d]
+            start[2, i, d] = acceleration[i, d]
+
+
+@numba.njit(cache=True)
+def _restore(position, velocity, acceleration, start) -> None:
+    """The motion back from ``start`` (`_keep`)."""
+    for i in range(position.shape[0]):
+        for d in range(2):
+            position[i, d] = start[0, i, d]
+            velocity[i, d] = start[1, i, d]
+            acceleration[i, d] = start[2, i, d]
+
+
+@numba.njit(cache=True, inline="always")
 def _finite(values: np.ndarray) -> bool:
     """Whether every entry of ``values`` (N, 2) is finite."""
     for i in range(values.shape[0]):
@@ -148,87 +284,79 @@ def _finite(values: np.ndarray) -> bool:
     return True
 
 
-@numba.njit(cache=True, error_model="numpy")
-def _with_sources(sources, mass):
-    """For each force f (a row of ``sources`` (F, N)), its particles with a source: their
-    indices, sources and inverse masses in the first ``counts[f]`` places of row f."""
-    forces, n = sources.shape
-    index = np.empty((forces, n), dtype=np.int64)
-    charged = np.empty((forces, n))
-    inverse_mass = np.empty((forces, n))
-    counts = np.zeros(forces, dtype=np.int64)
-    for f in range(forces):
-        for i in range(n):
-            if sources[f, i] != 0.0:
-                c = counts[f]
-                index[f, c] = i
-                charged[f, c] = sources[f, i]
-                inverse_mass[f, c] = 1.0 / mass[i]
-                counts[f] = c + 1
-    return index, charged, inverse_mass, counts
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffer) -> None:
+    """The pair sums (4, m) into ``sums`` of the m particles with a source (``index``, sources
+    ``charged``) at ``position`` (N, 2) (`collidium.kernels.pairwise.pair_sums`, as
+    `collidium.kernels.pairwise.inverse_distance_direct` takes them), their coordinates
+    gathered into ``x`` and ``y``."""
+    for c in range(index.shape[0]):
+        x[c] = position[index[c], 0]
+        y[c] = position[index[c], 1]
+    pair_sums(x, y, charged, coupling, softening2, 0.0, 0.0, False, sums, buffer)
 
 
-@numba.njit(cache=True, error_model="numpy")
-def _accelerations(position, mass, index, charged, counts, couplings, softening2, work, buffer,
-                   out):  # fmt: skip
-    """The accelerations (N, 2) of the pair forces into ``out`` (the sum of the forces over the
-    masses, as `collidium.forces.base.ForceField.evaluate` forms them), by the pair sums of
-    `collidium.kernels.pairwise.inverse_distance_direct` in ``buffer`` (4 N (1 + MOST_BLOCKS /
-    2)); their energies are not used."""
-    n = position.shape[0]
-    out[:, :] = 0.0
-    for f in range(counts.shape[0]):
-        m = counts[f]
-        x, y = work[0, :m], work[1, :m]
-        for c in range(m):
-            x[c] = position[index[f, c], 0]
-            y[c] = position[index[f, c], 1]
-        sums = buffer[: 4 * m].reshape((4, m))  # contiguous, as `pair_sums` is compiled for
-        pair_sums(x, y, charged[f, :m], couplings[f], softening2[f], 0.0, 0.0, False, sums,
-                  buffer[4 * m :])  # fmt: skip
-        for c in range(m):
-            i = index[f, c]
-            out[i, 0] += sums[0, c]
-            out[i, 1] += sums[1, c]
-    for i in range(n):
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _accelerations(position, mass, coupling, softening2, index, charged, x, y, sums, buffer,
+                   out) -> None:  # fmt: skip
+    """The accelerations (N, 2) of the pair force into ``out``: its forces over the masses, as
+    `collidium.forces.base.ForceField.evaluate` forms them (`_pair_sums`)."""
+    _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffer)
+    for i in range(position.shape[0]):  # loops: an array expression costs more than 3 bodies
+        out[i, 0] = 0.0
+        out[i, 1] = 0.0
+    for c in range(index.shape[0]):
+        out[index[c], 0] += sums[0, c]
+        out[index[c], 1] += sums[1, c]
+    for i in range(position.shape[0]):
         out[i, 0] /= mass[i]
         out[i, 1] /= mass[i]
 
 
-@numba.njit(cache=True, error_model="numpy")  # that of the inlined rows
-def _stiffness(position, velocity, index, charged, inverse_mass, counts, couplings, softening2,
-               work) -> float:  # fmt: skip
-    """The largest ``(|U_ij| rate_ij^2)^2`` over the pairs of every force, J^2/s^4
-    (`collidium.kernels.pairwise.inverse_distance_stiffness`, by its rows)."""
-    stiffness = 0.0
-    for f in range(counts.shape[0]):
-        m = counts[f]
-        x, y, vx, vy = work[0, :m], work[1, :m], work[2, :m], work[3, :m]
-        for c in range(m):
-            i = index[f, c]
-            x[c], y[c] = position[i, 0], position[i, 1]
-            vx[c], vy[c] = velocity[i, 0], velocity[i, 1]
-        for c in range(m):
-            row = stiffness_row(c, x, y, vx, vy, charged[f, :m], inverse_mass[f, :m],
-                                 couplings[f], softening2[f], 0.0, 0.0, False)  # fmt: skip
-            stiffness = larger(stiffness, row)
-    return stiffness
+@numba.njit(cache=True, error_model="numpy")
+def _potential(position, coupling, softening2, sources) -> float:
+    """The potential energy (J) of the pair force: its pair energies halved to the particles and
+    summed in particle order, as `collidium.forces.base.ForceField` sums them
+    (`collidium.kernels.sums.ordered_sum`; the particles without a source add nothing).
+    ``sources``: the arrays of `_work` from the indices to the sums' buffer."""
+    index, charged, _, x, y, _, _, sums, buffer = sources
+    _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffer)
+    energy = 0.0
+    for c in range(sums.shape[1]):
+        energy += 0.5 * sums[2, c]
+    return 0.0 + energy  # the field adds its forces' energies to 0
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _squared_rate(position, velocity, mass, index, charged, inverse_mass, counts, couplings,
-                  softening2, work, total, floor) -> float:  # fmt: skip
-    """`collidium.integrators._squared_rate` of pair forces alone, 1/s^2, given the total
-    energy (J): the stiffness (`_stiffness`) over the energy scale."""
-    stiffness = _stiffness(position, velocity, index, charged, inverse_mass, counts, couplings,
-                           softening2, work)  # fmt: skip
+def _squared_rate(position, velocity, mass, coupling, softening2, total, floor, sources) -> float:
+    """`_rate` with the arrays of `_work` from the indices to the sums' buffer (``sources``)."""
+    index, charged, inverse_mass, x, y, vx, vy, _, _ = sources
+    return _rate(position, velocity, mass, coupling, softening2, total, floor, index, charged,
+                 inverse_mass, x, y, vx, vy)  # fmt: skip
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")  # that of the inlined rows
+def _rate(position, velocity, mass, coupling, softening2, total, floor, index, charged,
+          inverse_mass, x, y, vx, vy) -> float:  # fmt: skip
+    """`collidium.integrators._squared_rate` of the pair force alone, 1/s^2, given the total
+    energy (J): the square root of the largest ``(|U_ij| rate_ij^2)^2`` over pairs
+    (`collidium.kernels.pairwise.inverse_distance_stiffness`, by its rows, from the particles
+    with a source ``index`` gathered into ``x, y, vx, vy``) over the energy scale."""
+    for c in range(index.shape[0]):
+        i = index[c]
+        x[c], y[c] = position[i, 0], position[i, 1]
+        vx[c], vy[c] = velocity[i, 0], velocity[i, 1]
+    stiffness = 0.0
+    for c in range(index.shape[0]):
+        row = stiffness_row(c, x, y, vx, vy, charged, inverse_mass, coupling, softening2, 0.0,
+                            0.0, False)  # fmt: skip
+        stiffness = larger(stiffness, row)
     scale = energy_scale(kinetic_energy(mass, velocity), total, floor)
     return math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
 
 
-@numba.njit(cache=True)
-def _meets_contact(position, velocity, radius, lag, shape, half_width, half_height, rim,
-                   segments, order, low, high) -> bool:  # fmt: skip
+@numba.njit(cache=True, inline="always")
+def _meets_contact(position, velocity, radius, lag, walls, order, low, high) -> bool:
     """Whether a straight flight of ``lag`` seconds may bring a disk to a wall or another disk
     (within `CONTACT_MARGIN`).
 
@@ -237,6 +365,7 @@ def _meets_contact(position, velocity, radius, lag, shape, half_width, half_heig
     sorted list); a pair is tested only if their intervals overlap, which two disks that meet
     must do."""
     n = position.shape[0]
+    shape, half_width, half_height, rim, segments = walls
     horizon = lag * (1.0 + CONTACT_MARGIN)
     for i in range(n):
         delay, _ = contacts.earliest(position[i, 0], position[i, 1], velocity[i, 0],
