@@ -234,14 +234,24 @@ class AdaptiveLeapfrog(Integrator):
         #: Regular substeps the next interval starts with (it may take more).
         self.substeps = 1
         self._flight: _SmoothFlight | None = None
+        #: Whether the last interval met a contact under forces (`step` then takes the next in
+        #: Python at once, as `fly` leaves it).
+        self.met_contact = False
+        #: The start (s) of the interval `fly` could not take, which `step` takes next.
+        self._refused: float | None = None
 
     def state(self) -> dict[str, np.ndarray]:
-        """The substep count the next interval starts with."""
-        return {"substeps": np.array([self.substeps], dtype=np.int64)}
+        """The substep count the next interval starts with, and whether the last met a
+        contact."""
+        return {
+            "substeps": np.array([self.substeps], dtype=np.int64),
+            "met_contact": np.array([self.met_contact]),
+        }
 
     def load_state(self, arrays: dict[str, np.ndarray]) -> None:
         """Take back what `state` returned (a missing count starts at 1)."""
         self.substeps = int(arrays["substeps"][0]) if "substeps" in arrays else 1
+        self.met_contact = bool(arrays["met_contact"][0]) if "met_contact" in arrays else False
 
     def needed(self, rate2: float, dt: float) -> int:
         """The fewest substeps, a power of two up to `MAX_SUBSTEPS`, that keep ``dt / n`` within
@@ -259,7 +269,12 @@ class AdaptiveLeapfrog(Integrator):
         tally: Tally,
     ) -> None:
         flight = self._flight_for(particles, vessel, field)
-        if flight is not None and self._fly(flight, particles, field, now, 0, dt, _ONE, _ONE):
+        refused, self._refused = self._refused, None
+        # An interval after one that met a contact likely meets one too (a gas): it is not
+        # tried whole, which would cost its substeps up to the contact twice.
+        tried = flight is not None and now != refused and not self.met_contact
+        if tried and self._fly(typing.cast(_SmoothFlight, flight), particles, field, now, 0, dt,
+                               _ONE, _ONE):  # fmt: skip
             return  # the interval met no contact: compiled whole
         start = _Snapshot(particles, tally)
         # The energy the substeps' rate is judged against: the interval's one read of the
@@ -280,7 +295,7 @@ class AdaptiveLeapfrog(Integrator):
         n = max(self.substeps, self.needed(rate2, dt))
         while True:
             try:
-                fastest = self._interval(
+                fastest, self.met_contact = self._interval(
                     particles, vessel, field, drift, flight, now, dt, tally, n, rate2, total
                 )
             except SimulationError:  # any stop inside the interval leaves the state it began from
@@ -322,10 +337,13 @@ class AdaptiveLeapfrog(Integrator):
         """Whole intervals that meet no contact, compiled (`Integrator.fly`,
         `collidium.kernels.substeps.smooth_intervals`): `step` takes each such interval by the
         same call, so both give the same bits."""
-        if not self.flies(particles, vessel, field):
+        if self.met_contact or not self.flies(particles, vessel, field):
             return 0
         flight = typing.cast(_SmoothFlight, self._flight)
-        return self._fly(flight, particles, field, origin, elapsed, dt, kinetic, potential)
+        flown = self._fly(flight, particles, field, origin, elapsed, dt, kinetic, potential)
+        if flown < kinetic.shape[0]:  # `step` takes that interval next: it need not try again
+            self._refused = origin + (elapsed + flown) * dt
+        return flown
 
     def _fly(
         self,
@@ -356,14 +374,14 @@ class AdaptiveLeapfrog(Integrator):
         n: int,
         fastest: float,
         total: float,
-    ) -> float:
+    ) -> tuple[float, bool]:
         """Take the interval in ``n`` regular substeps (each split at contacts), those that meet
-        no contact by the compiled ``flight`` where there is one; returns the largest squared
+        no contact by the compiled ``flight`` where there is one. Returns the largest squared
         rate (1/s^2) met at their boundaries (the regular ones: they are the same forwards and
         backwards, and contacts come with their own substep boundaries), starting from
         ``fastest``, the interval's start's (`_squared_rate`, with the ``total`` energy J at the
         start and the energy given since: by the velocity forces, the walls, a piston and
-        inelastic collisions)."""
+        inelastic collisions); and whether a contact shortened a substep."""
         t = now
         contacts = 0
         given = _given(tally)
@@ -386,7 +404,7 @@ class AdaptiveLeapfrog(Integrator):
             now_total = total + (_given(tally) - given)
             fastest = max(fastest, _squared_rate(particles, vessel, field, now_total))
             s += 1
-        return fastest
+        return fastest, contacts > 0
 
     def _substep(
         self,
