@@ -365,24 +365,38 @@ class StateReader:
 )
 def test_steps_flown_in_one_call_are_bitwise_those_taken_one_by_one(name, time):
     """A small charged scene flies the steps between the observers that read its state in one
-    compiled call: the run ends bit for bit as one whose observer reads every step, its energy
-    drift (read every step and every seventh) and its contacts included. charged-opposite
-    collides, the charged gas meets a contact in most substeps."""
+    compiled call: the run ends bit for bit as one whose observer reads every step, and the
+    observers that take what a flight records (energy drift every step and every seventh, the
+    energy series, the thermodynamics and the collision counts every third) measure bit for bit
+    the same. charged-opposite collides, the charged gas meets a contact in most substeps."""
     runs = []
     for reader in (StateReader(Every(250)), StateReader(Every(1))):
         sim = cd.load(name)
-        drifts = [cd.observers.EnergyDrift(), cd.observers.EnergyDrift(7)]
-        sim.observers += [*drifts, reader]
+        measured = [cd.observers.EnergyDrift(), cd.observers.EnergyDrift(7),
+                    cd.observers.EnergySeries(), cd.observers.Thermo(3),
+                    cd.observers.CollisionRate(3)]  # fmt: skip
+        sim.observers += [*measured, reader]
         sim.run(time=time)
-        runs.append((sim, drifts))
-    (flown, flown_drifts), (stepped, stepped_drifts) = runs
+        runs.append((sim, measured))
+    (flown, ours), (stepped, theirs) = runs
     np.testing.assert_array_equal(flown.particles.position, stepped.particles.position)
     np.testing.assert_array_equal(flown.particles.velocity, stepped.particles.velocity)
     assert flown._integrator.substeps == stepped._integrator.substeps
     assert flown.counters == stepped.counters
-    for ours, theirs in zip(flown_drifts, stepped_drifts, strict=True):
-        assert ours.samples == theirs.samples
-        assert ours.max_rel_drift == theirs.max_rel_drift > 0.0
+    for a, b in zip(ours, theirs, strict=True):
+        assert a.samples == b.samples
+        assert a.summary() == b.summary() or _same_with_nan(a.summary(), b.summary())
+    assert ours[0].max_rel_drift > 0.0
+    for column in ("time", "kinetic", "potential", "total_speed", "momentum"):
+        np.testing.assert_array_equal(getattr(ours[2], column), getattr(theirs[2], column))
+
+
+def _same_with_nan(a: dict, b: dict) -> bool:
+    """Whether two summaries are equal, NaN equal to NaN."""
+    return a.keys() == b.keys() and all(
+        x == y or (isinstance(x, float) and math.isnan(x) and math.isnan(y))
+        for x, y in zip(a.values(), b.values(), strict=True)
+    )
 
 
 def test_small_scenes_fly_between_the_observers_that_read_the_state(monkeypatch):

@@ -134,10 +134,9 @@ class Integrator:
         origin: float,
         elapsed: int,
         dt: float,
-        kinetic: FloatArray,
-        potential: FloatArray,
+        record: FloatArray,
     ) -> int:
-        """Take up to ``len(kinetic)`` steps of ``dt`` (s) in one compiled call, as `step` would
+        """Take up to ``len(record)`` steps of ``dt`` (s) in one compiled call, as `step` would
         take them one by one, bit for bit, up to the first that this call cannot take (which
         is left as it began); returns how many it took.
 
@@ -151,9 +150,10 @@ class Integrator:
             Steps from the clock's origin to the first step's start.
         dt : float
             The reporting interval, s.
-        kinetic, potential : ndarray, shape (K,)
-            Output: the kinetic and potential energy (J) after each step taken, as
-            `collidium.simulation.Simulation.energy` gives them.
+        record : ndarray, shape (K, len(collidium.kernels.substeps.RECORD))
+            Output: the energies, virial, momentum and total speed after each step taken
+            (`collidium.kernels.substeps.RECORD`), as `collidium.simulation.Simulation` gives
+            them.
         """
         return 0
 
@@ -274,7 +274,7 @@ class AdaptiveLeapfrog(Integrator):
         # tried whole, which would cost its substeps up to the contact twice.
         tried = flight is not None and now != refused and not self.met_contact
         if tried and self._fly(typing.cast(_SmoothFlight, flight), particles, field, now, 0, dt,
-                               _ONE, _ONE):  # fmt: skip
+                               _ONE):  # fmt: skip
             return  # the interval met no contact: compiled whole
         start = _Snapshot(particles, tally)
         # The energy the substeps' rate is judged against: the interval's one read of the
@@ -331,8 +331,7 @@ class AdaptiveLeapfrog(Integrator):
         origin: float,
         elapsed: int,
         dt: float,
-        kinetic: FloatArray,
-        potential: FloatArray,
+        record: FloatArray,
     ) -> int:
         """Whole intervals that meet no contact, compiled (`Integrator.fly`,
         `collidium.kernels.substeps.smooth_intervals`): `step` takes each such interval by the
@@ -340,8 +339,8 @@ class AdaptiveLeapfrog(Integrator):
         if self.met_contact or not self.flies(particles, vessel, field):
             return 0
         flight = typing.cast(_SmoothFlight, self._flight)
-        flown = self._fly(flight, particles, field, origin, elapsed, dt, kinetic, potential)
-        if flown < kinetic.shape[0]:  # `step` takes that interval next: it need not try again
+        flown = self._fly(flight, particles, field, origin, elapsed, dt, record)
+        if flown < record.shape[0]:  # `step` takes that interval next: it need not try again
             self._refused = origin + (elapsed + flown) * dt
         return flown
 
@@ -353,11 +352,10 @@ class AdaptiveLeapfrog(Integrator):
         origin: float,
         elapsed: int,
         dt: float,
-        kinetic: FloatArray,
-        potential: FloatArray,
+        record: FloatArray,
     ) -> int:
         flown, self.substeps = flight.intervals(
-            particles, field, origin, elapsed, dt, self.substeps, self.tolerance, kinetic, potential
+            particles, field, origin, elapsed, dt, self.substeps, self.tolerance, record
         )
         return flown
 
@@ -615,18 +613,16 @@ class _SmoothFlight:
         dt: float,
         starting: int,
         tolerance: float,
-        kinetic: FloatArray,
-        potential: FloatArray,
+        record: FloatArray,
     ) -> tuple[int, int]:
-        """Whole intervals, up to ``len(kinetic)``, that meet no contact, the first taken with
+        """Whole intervals, up to ``len(record)``, that meet no contact, the first taken with
         ``starting`` substeps or more (`collidium.kernels.substeps.smooth_intervals`):
         ``(intervals taken, the substep count the next starts from)``. The field's acceleration
         is kept current."""
         flown, after = substeps.smooth_intervals(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
             self.source, self.coupling, self.softening2, *self.walls, origin, elapsed, dt,
-            kinetic.shape[0], starting, tolerance, MAX_SUBSTEPS, TOTAL_ENERGY_FLOOR, kinetic,
-            potential,
+            record.shape[0], starting, tolerance, MAX_SUBSTEPS, TOTAL_ENERGY_FLOOR, record,
         )  # fmt: skip
         return int(flown), int(after)
 
@@ -658,8 +654,8 @@ class _SmoothFlight:
         )  # fmt: skip
 
 
-#: The energies of a single compiled interval, not read (`AdaptiveLeapfrog._with_forces`).
-_ONE = np.empty(1)
+#: The record of a single compiled interval, not read (`AdaptiveLeapfrog._with_forces`).
+_ONE = np.empty((1, len(substeps.RECORD)))
 
 
 class _Snapshot:

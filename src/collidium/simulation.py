@@ -11,10 +11,10 @@ Run loop, one step of length dt (the reporting interval):
 3. audit: a NaN/infinity or a particle outside the vessel stops the run with `SimulationError`;
 4. observers whose trigger fires (``trigger(sim)``) are updated.
 
-Where the integrator can (a small scene under direct pair forces: `Integrator.fly`), the steps
+Where the integrator can (a small scene under a direct pair force: `Integrator.fly`), the steps
 before the next observer that reads the state are taken in one compiled call, bit for bit as one
-by one; observers that read the energies alone (`collidium.observers.EnergyDrift`) get those of
-each step from it.
+by one; observers that read no more than the energies, virial, momentum and total speed
+(``take_flown``: `collidium.observers.Flown`) get those of each of their steps from it.
 """
 
 from __future__ import annotations
@@ -42,10 +42,11 @@ from collidium.integrators import (
     make_integrator,
 )
 from collidium.io.checkpoint import read_checkpoint, saved_vessel, write_checkpoint
+from collidium.kernels import sums
 from collidium.kernels.audit import first_invalid
 from collidium.kernels.cells import first_overlap, grid_shape, grid_window, window_sides
-from collidium.kernels.sums import kinetic_energy
-from collidium.observers.base import Every, Observer
+from collidium.kernels.substeps import RECORD
+from collidium.observers.base import Every, Flown, Observer
 from collidium.state import PROPERTIES, FloatArray, Particles, as_given
 from collidium.vessels import OUTSIDE_TOLERANCE, Vessel, vessel_from_dict
 from collidium.vessels.walls import check_restitution
@@ -419,43 +420,43 @@ class Simulation:
 
     def _run_length(self, left: int) -> int:
         """Steps, up to ``left`` and `MOST_FLOWN`, until an observer reads the state: one unless
-        the integrator can fly here and every trigger is an `Every`. Those that read the
-        energies alone (``take_energies``) do not count: they get the flown steps' energies."""
+        the integrator can fly here and every trigger is an `Every`. Those that read no more
+        than a flight records (``take_flown``, `collidium.observers.Flown`) do not count."""
         run = min(left, MOST_FLOWN)
         for observer in self.observers:
             trigger = observer.trigger
             if not isinstance(trigger, Every):
                 return 1
-            if not hasattr(observer, "take_energies"):
+            if not hasattr(observer, "take_flown"):
                 run = min(run, trigger.period - self.steps % trigger.period)
         if run > 1 and not self._integrator.flies(self.particles, self.container, self._field):
             return 1
         return run
 
     def _fly(self, run: int) -> int:
-        """Up to ``run`` steps in one compiled call; the observers that read the energies get
-        those of the steps on which they fire, and after the last step, if it was taken, the
-        others fire as after any step. Returns the steps taken."""
-        kinetic, potential = np.empty(run), np.empty(run)
+        """Up to ``run`` steps in one compiled call; the observers that read no more than its
+        record get what they would have read on each step they fire on, and after the last
+        step, if it was taken, the others fire as after any step. Returns the steps taken."""
+        record = np.empty((run, len(RECORD)))
         first = self.steps
         origin, start = self._time_origin
         flown = self._integrator.fly(
-            self.particles, self.container, self._field, origin, first - start, self.dt, kinetic,
-            potential,
-        )  # fmt: skip
+            self.particles, self.container, self._field, origin, first - start, self.dt, record
+        )
         if flown == 0:
             return 0
         self.steps += flown
         self._audit()
-        fired = np.arange(first + 1, self.steps + 1)
+        steps = np.arange(first + 1, self.steps + 1)
+        times = origin + (steps - start) * self.dt  # as `time` counts them
         for observer in self.observers:
-            if hasattr(observer, "take_energies"):
-                at = fired % typing.cast(Every, observer.trigger).period == 0
+            if hasattr(observer, "take_flown"):
+                at = steps % typing.cast(Every, observer.trigger).period == 0
                 if at.any():
-                    observer.take_energies(self, kinetic[:flown][at], potential[:flown][at])
+                    observer.take_flown(self, Flown(times[at], *record[:flown][at].T))
         if flown == run:
             for observer in self.observers:
-                if not hasattr(observer, "take_energies") and observer.trigger(self):
+                if not hasattr(observer, "take_flown") and observer.trigger(self):
                     observer.update(self)
         return flown
 
@@ -501,7 +502,7 @@ class Simulation:
 
     def _kinetic(self) -> float:
         # In particle order, as the compiled intervals sum it (`collidium.kernels.sums`).
-        return float(kinetic_energy(writable(self.particles.mass), self.particles.velocity))
+        return float(sums.kinetic_energy(writable(self.particles.mass), self.particles.velocity))
 
     def temperature(self) -> float:
         """kT = KE / N in J (2 degrees of freedom per particle, Boltzmann's constant 1); NaN
@@ -521,7 +522,7 @@ class Simulation:
 
     def momentum(self) -> FloatArray:
         """Total momentum ``sum m v``, shape (2,), in kg m/s."""
-        return np.asarray(self.particles.mass @ self.particles.velocity)
+        return np.array(sums.momentum(writable(self.particles.mass), self.particles.velocity))
 
     def angular_momentum(self) -> float:
         """Total angular momentum about the origin, ``sum m (x v_y - y v_x)``, kg m^2/s: conserved
@@ -532,7 +533,7 @@ class Simulation:
 
     def total_speed(self) -> float:
         """Sum of the particles' speeds in m/s (the seed's "total speed", Fig. 2)."""
-        return float(np.sum(np.hypot(self.particles.velocity[:, 0], self.particles.velocity[:, 1])))
+        return float(sums.total_speed(self.particles.velocity))
 
     @property
     def counters(self) -> Counters:

@@ -921,27 +921,31 @@ def smooth_intervals(
     most: int,
     energy_floor: float,
     margin: float,
-) -> tuple[int, int, list[float], list[float]]:
+) -> tuple[int, int, FloatArray]:
     """Twin of `substeps.smooth_intervals`: interval by interval, the substep count from the
     rate at its start (`needed`), `smooth_substeps` from its first substep, taken again with
     more substeps while a boundary needs more; the first interval that meets a contact is put
-    back as it began. Returns ``(intervals taken, the next count, kinetic and potential
-    energies after each)``."""
-    kinetic: list[float] = []
-    potential: list[float] = []
+    back as it began. Returns ``(intervals taken, the next count, the record of each: kinetic
+    and potential energy, pair virial, momentum x and y, total speed)``."""
+    record = []
 
-    def energies() -> tuple[float, float]:
+    def energies() -> tuple[float, float, float]:
         moving = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1)))
-        pairs = float(inverse_distance_direct(position, source, coupling, softening2)[1].sum())
-        return moving, pairs
+        _, energy, virial = inverse_distance_direct(position, source, coupling, softening2)
+        return moving, float(energy.sum()), float(virial.sum())
+
+    def table_row() -> tuple[float, ...]:
+        px, py = mass @ velocity
+        speeds = float(np.sum(np.hypot(velocity[:, 0], velocity[:, 1])))
+        return (*energies(), float(px), float(py), speeds)
 
     for k in range(count):
         now = origin + (elapsed + k) * dt
-        total = sum(energies())
+        total = sum(energies()[:2])
         rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, total,
                              energy_floor)  # fmt: skip
         if not dt * math.sqrt(rate2) <= most * tolerance:
-            return k, substeps, kinetic, potential
+            return k, substeps, np.array(record).reshape(-1, 6)
         taken = max(substeps, needed(rate2, dt, tolerance, most))
         start = [a.copy() for a in (position, velocity, acceleration)]
         while True:
@@ -956,12 +960,10 @@ def smooth_intervals(
                 for array, kept in zip((position, velocity, acceleration), start, strict=True):
                     array[...] = kept
             if met:
-                return k, substeps, kinetic, potential
+                return k, substeps, np.array(record).reshape(-1, 6)
             if required <= taken:
                 break
             taken = max(required, 2 * taken)
         substeps = max(1, taken // 2) if required <= taken // 2 else taken
-        moving, pairs = energies()
-        kinetic.append(moving)
-        potential.append(pairs)
-    return count, substeps, kinetic, potential
+        record.append(table_row())
+    return count, substeps, np.array(record).reshape(-1, 6)

@@ -11,6 +11,12 @@ being finite: the integrator takes that one in Python, where the collision modes
 messages are (the divisions here follow NumPy: an overflow gives inf, which stops the
 substeps). The two paths differ by round-off only: the exact engine advances a disk at each
 cell crossing, in two roundings where the straight flight here takes one.
+
+`smooth_intervals` goes further: it takes whole reporting intervals, as many as meet no contact,
+with the integrator's choice of their substep counts and its retries, and records the energies,
+virial, momentum and total speed at each interval's end (`RECORD`), so that a small scene runs
+many steps between the observers that read more of its state in one call. An interval that meets
+a contact is left to the integrator whole.
 """
 
 from __future__ import annotations
@@ -22,8 +28,12 @@ import numpy as np
 
 from collidium.kernels.pairwise import MOST_BLOCKS, larger, pair_sums, stiffness_row
 from collidium.kernels.sorting import sort_nearly_sorted
-from collidium.kernels.sums import kinetic_energy
+from collidium.kernels.sums import kinetic_energy, momentum, total_speed
 from collidium.kernels.vessels import contacts
+
+#: What `smooth_intervals` records of each interval's end, its columns: the kinetic and potential
+#: energy (J), the pair virial (J), the momentum (kg m/s) and the sum of the speeds (m/s).
+RECORD = ("kinetic", "potential", "virial", "px", "py", "total_speed")
 
 #: Relative margin of the contact test: a disk that comes within this fraction of its radius (or
 #: of a pair's contact distance) of a contact, within this fraction past the substep, counts as
@@ -98,7 +108,7 @@ def smooth_substeps(
 def smooth_intervals(
     position, velocity, acceleration, mass, radius, source, coupling, softening2,
     shape, half_width, half_height, rim, segments, origin, elapsed, dt, count, substeps,
-    tolerance, most_substeps, energy_floor, kinetic, potential,
+    tolerance, most_substeps, energy_floor, record,
 ) -> tuple[int, int]:  # fmt: skip
     """Up to ``count`` whole reporting intervals of ``dt`` (s), in place, each as the adaptive
     integrator takes one (`collidium.integrators.AdaptiveLeapfrog`), up to the first that meets
@@ -122,7 +132,7 @@ def smooth_intervals(
     dt : float
         The reporting interval, s.
     count : int
-        Most intervals to take.
+        Most intervals to take (at most ``len(record)``).
     substeps : int
         The substep count the first interval starts from.
     tolerance : float
@@ -131,9 +141,10 @@ def smooth_intervals(
         Most substeps in an interval (a power of two).
     energy_floor : float
         As in `smooth_substeps`.
-    kinetic, potential : ndarray, shape (count,)
-        Output: the kinetic and potential energy (J) at each interval's end, summed as
-        `collidium.simulation.Simulation.energy` sums them (`collidium.kernels.sums`).
+    record : ndarray, shape (count, len(RECORD))
+        Output: the `RECORD` of each interval's end, summed as `collidium.simulation.Simulation`
+        sums them (`collidium.kernels.sums`, and the pair force's as
+        `collidium.forces.base.ForceField` sums them).
 
     Returns
     -------
@@ -145,7 +156,7 @@ def smooth_intervals(
     walls = (shape, half_width, half_height, rim, segments)
     start = np.empty((3, n, 2))
     sources = work[3:12]
-    energy = _potential(position, coupling, softening2, sources)
+    energy, virial = _energies(position, coupling, softening2, sources)
     for k in range(count):
         now = origin + (elapsed + k) * dt
         total = kinetic_energy(mass, velocity) + energy
@@ -168,9 +179,14 @@ def smooth_intervals(
             _restore(position, velocity, acceleration, start)
             taken = max(required, 2 * taken)
         substeps = max(1, taken // 2) if required <= taken // 2 else taken
-        energy = _potential(position, coupling, softening2, sources)
-        kinetic[k] = kinetic_energy(mass, velocity)
-        potential[k] = energy
+        energy, virial = _energies(position, coupling, softening2, sources)
+        px, py = momentum(mass, velocity)
+        record[k, 0] = kinetic_energy(mass, velocity)
+        record[k, 1] = energy
+        record[k, 2] = virial
+        record[k, 3] = px
+        record[k, 4] = py
+        record[k, 5] = total_speed(velocity)
     return count, substeps
 
 
@@ -314,17 +330,19 @@ def _accelerations(position, mass, coupling, softening2, index, charged, x, y, s
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _potential(position, coupling, softening2, sources) -> float:
-    """The potential energy (J) of the pair force: its pair energies halved to the particles and
-    summed in particle order, as `collidium.forces.base.ForceField` sums them
+def _energies(position, coupling, softening2, sources) -> tuple[float, float]:
+    """The potential energy and the pair virial (J) of the pair force: its pair sums halved to
+    the particles and summed in particle order, as `collidium.forces.base.ForceField` sums them
     (`collidium.kernels.sums.ordered_sum`; the particles without a source add nothing).
     ``sources``: the arrays of `_work` from the indices to the sums' buffer."""
     index, charged, _, x, y, _, _, sums, buffer = sources
     _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffer)
     energy = 0.0
+    virial = 0.0
     for c in range(sums.shape[1]):
         energy += 0.5 * sums[2, c]
-    return 0.0 + energy  # the field adds its forces' energies to 0
+        virial += 0.5 * sums[3, c]
+    return 0.0 + energy, 0.0 + virial  # the field adds its forces' sums to 0
 
 
 @numba.njit(cache=True, error_model="numpy")

@@ -1,13 +1,15 @@
-"""Energies summed in particle order, compiled: the same bits in every path that sums them.
+"""Sums over the particles in particle order, compiled: the same bits in every path that sums.
 
-The kinetic energy and the potential energy a run reports (`collidium.simulation.Simulation.energy`)
-and those the adaptive integrator's compiled intervals record at each step
+The energies, momentum and total speed a run reports (`collidium.simulation.Simulation`) and
+those the adaptive integrator's compiled intervals record at each step
 (`collidium.kernels.substeps.smooth_intervals`) are summed by these loops, one value after the
 other from 0: without fast-math flags LLVM keeps that order, so a run flown many steps in one
-call reports its energies bit for bit as one stepped by Python would.
+call reports them bit for bit as one stepped by Python would.
 """
 
 from __future__ import annotations
+
+import math
 
 import numba
 import numpy as np
@@ -15,12 +17,31 @@ import numpy as np
 
 @numba.njit(cache=True)
 def kinetic_energy(mass: np.ndarray, velocity: np.ndarray) -> float:
-    """``sum m v^2 / 2`` in J of masses (N,) in kg and velocities (N, 2) in m/s, summed in
-    particle order."""
+    """``sum m v^2 / 2`` in J of masses (N,) in kg and velocities (N, 2) in m/s."""
     total = 0.0
     for i in range(mass.shape[0]):
         total += mass[i] * (velocity[i, 0] * velocity[i, 0] + velocity[i, 1] * velocity[i, 1])
     return 0.5 * total
+
+
+@numba.njit(cache=True)
+def momentum(mass: np.ndarray, velocity: np.ndarray) -> tuple[float, float]:
+    """``sum m v``, (x, y) in kg m/s, of masses (N,) in kg and velocities (N, 2) in m/s."""
+    px = 0.0
+    py = 0.0
+    for i in range(mass.shape[0]):
+        px += mass[i] * velocity[i, 0]
+        py += mass[i] * velocity[i, 1]
+    return px, py
+
+
+@numba.njit(cache=True)
+def total_speed(velocity: np.ndarray) -> float:
+    """``sum |v|`` in m/s of velocities (N, 2) in m/s."""
+    total = 0.0
+    for i in range(velocity.shape[0]):
+        total += math.hypot(velocity[i, 0], velocity[i, 1])
+    return total
 
 
 @numba.njit(cache=True)

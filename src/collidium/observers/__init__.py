@@ -6,7 +6,15 @@ also be used on its own, freud-style: ``obs.compute(sim)`` returns the observer,
 accumulates, ``obs.plot(ax)`` draws it.
 """
 
-from collidium.observers.base import After, Every, Interval, Measurement, Observer, Trigger
+from collidium.observers.base import (
+    After,
+    Every,
+    Flown,
+    Interval,
+    Measurement,
+    Observer,
+    Trigger,
+)
 from collidium.observers.counters import CollisionRate
 from collidium.observers.effusion import Effusion
 from collidium.observers.energy import EnergyDrift, EnergySeries
@@ -23,6 +31,7 @@ __all__ = [
     "EnergyDrift",
     "EnergySeries",
     "Every",
+    "Flown",
     "Interval",
     "Measurement",
     "Observer",

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol, Self, runtime_checkable
 
 from collidium.errors import InputError
+from collidium.state import FloatArray
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -109,10 +110,44 @@ def as_trigger(trigger: Trigger | int | None) -> Trigger:
     return trigger
 
 
+@dataclass(frozen=True)
+class Flown:
+    """What a run records of the steps it flew in one compiled call (`Simulation.run`, a small
+    charged scene), at those an observer's trigger fired on. The rest of the state the
+    observers read (the tallies, the vessel) did not change in between: nothing touched a wall
+    or another disk. Arrays (K,), one value per step, as `Simulation` gives them.
+
+    Attributes
+    ----------
+    time : ndarray
+        Simulated time in s.
+    kinetic, potential, virial : ndarray
+        Kinetic and potential energy and pair virial in J (`Simulation.energy`,
+        `Simulation.virial`).
+    px, py : ndarray
+        Total momentum in kg m/s.
+    total_speed : ndarray
+        Sum of the speeds in m/s.
+    """
+
+    time: FloatArray
+    kinetic: FloatArray
+    potential: FloatArray
+    virial: FloatArray
+    px: FloatArray
+    py: FloatArray
+    total_speed: FloatArray
+
+
 @runtime_checkable
 class Observer(Protocol):
     """What the run loop calls: ``attach`` once before the first step, then ``update`` after each
-    step on which ``trigger(sim)`` is true."""
+    step on which ``trigger(sim)`` is true.
+
+    An observer whose trigger is an `Every` and that reads no more than a `Flown` holds may
+    also have ``take_flown(sim, flown)``: a small charged scene then flies the steps between
+    the other observers' firings in one compiled call and hands it what it would have read at
+    each of its own (`EnergyDrift`, `EnergySeries`, `Thermo`, `CollisionRate` do)."""
 
     trigger: Trigger
 

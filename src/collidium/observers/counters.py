@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from collidium.observers.base import Measurement, Trigger, new_axes
+from collidium.observers.base import Flown, Measurement, Trigger, new_axes
 from collidium.state import FloatArray
 
 if TYPE_CHECKING:
@@ -40,6 +40,15 @@ class CollisionRate(Measurement):
         self._time.append(sim.time)
         self._counts.append(sim.tally.counts.copy())
         self._mean_speed.append(sim.total_speed() / max(sim.particles.n, 1))
+
+    def take_flown(self, sim: Simulation, flown: Flown) -> None:
+        """Samples of steps the run flew in one compiled call (`Flown`), as `update` after
+        each: nothing collided in between, so the counts are those of now."""
+        counts = sim.tally.counts.copy()
+        self._time += flown.time.tolist()
+        self._counts += [counts] * flown.time.shape[0]
+        self._mean_speed += (flown.total_speed / max(sim.particles.n, 1)).tolist()
+        self.samples += flown.time.shape[0]
 
     @property
     def time(self) -> FloatArray:

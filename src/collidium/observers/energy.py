@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from collidium.observers.base import Measurement, Trigger, new_axes
+from collidium.observers.base import Flown, Measurement, Trigger, new_axes
 from collidium.state import FloatArray
 
 if TYPE_CHECKING:
@@ -49,6 +49,14 @@ class EnergySeries(Measurement):
         e = sim.energy()
         px, py = sim.momentum()
         self._rows.append((sim.time, e.kinetic, e.potential, sim.total_speed(), px, py))
+
+    def take_flown(self, sim: Simulation, flown: Flown) -> None:
+        """Samples of steps the run flew in one compiled call (`Flown`), as `update` after
+        each."""
+        columns = (flown.time, flown.kinetic, flown.potential, flown.total_speed, flown.px,
+                   flown.py)  # fmt: skip
+        self._rows += zip(*(column.tolist() for column in columns), strict=True)
+        self.samples += flown.time.shape[0]
 
     def _column(self, name: str) -> FloatArray:
         table = np.asarray(self._rows, dtype=float).reshape(-1, len(_COLUMNS))
@@ -201,14 +209,13 @@ class EnergyDrift(Measurement):
     def _sample(self, sim: Simulation) -> None:
         self._take(conserved_energy(sim))
 
-    def take_energies(self, sim: Simulation, kinetic: FloatArray, potential: FloatArray) -> None:
-        """Samples of the kinetic and potential energies (K,) in J of steps the run took in one
-        compiled call, on which the trigger fired (`collidium.simulation.Simulation.run`): the
-        same as `update` after each, since nothing was given to the disks in between."""
+    def take_flown(self, sim: Simulation, flown: Flown) -> None:
+        """Samples of steps the run flew in one compiled call (`Flown`): the same as `update`
+        after each, nothing having been given to the disks in between."""
         given = _given(sim)
-        for total in (kinetic + potential).tolist():
+        for total in (flown.kinetic + flown.potential).tolist():
             self._take(total - given)
-        self.samples += kinetic.shape[0]
+        self.samples += flown.time.shape[0]
 
     def _take(self, conserved: float) -> None:
         scale = max(abs(self.initial_total), 1e-300)

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from collidium.observers.base import Measurement, Trigger, new_axes
+from collidium.observers.base import Flown, Measurement, Trigger, new_axes
 from collidium.state import FloatArray
 
 if TYPE_CHECKING:
@@ -85,12 +85,29 @@ class Thermo(Measurement):
     def _sample(self, sim: Simulation) -> None:
         self._time.append(sim.time)
         self._kT.append(sim.temperature())
-        self._impulse.append(sim.tally.impulse.copy())
         self._force_virial.append(sim.virial())
+        self._take_walls(sim, 1)
+
+    def take_flown(self, sim: Simulation, flown: Flown) -> None:
+        """Samples of steps the run flew in one compiled call (`Flown`), as `update` after
+        each: no wall was hit in between, so the walls' impulses are those of now."""
+        n = sim.particles.n
+        self._time += flown.time.tolist()
+        self._kT += (flown.kinetic / n).tolist() if n else [float("nan")] * flown.time.shape[0]
+        self._force_virial += flown.virial.tolist()
+        self._take_walls(sim, flown.time.shape[0])
+        self.samples += flown.time.shape[0]
+
+    def _take_walls(self, sim: Simulation, samples: int) -> None:
+        """The walls' impulses, contact lengths and the area available now, ``samples`` times."""
         state = sim.piston()
         piston = None if state is None else state.position
-        self._contact.append(sim.container.contact_lengths(self._radius, piston))
-        self._area.append(sim.container.available_area(self._radius, piston))
+        impulse = sim.tally.impulse.copy()
+        contact = sim.container.contact_lengths(self._radius, piston)
+        area = sim.container.available_area(self._radius, piston)
+        self._impulse += [impulse] * samples
+        self._contact += [contact] * samples
+        self._area += [area] * samples
 
     @property
     def contact(self) -> FloatArray:
