@@ -927,7 +927,7 @@ def smooth_intervals(
     more substeps while a boundary needs more; the first interval that meets a contact is put
     back as it began. Returns ``(intervals taken, the next count, the record of each: kinetic
     and potential energy, pair virial, momentum x and y, total speed)``."""
-    record = []
+    record: list[tuple[float, ...]] = []
 
     def energies() -> tuple[float, float, float]:
         moving = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1)))
