@@ -221,6 +221,11 @@ class AdaptiveLeapfrog(Integrator):
     synchronised velocities. A collision then costs one more force evaluation and its error is
     that of the smooth substeps around it.
 
+    In a small scene under one direct pair force (`_SmoothFlight`), an interval that meets no
+    contact is taken whole by one compiled call (`collidium.kernels.substeps.smooth_intervals`),
+    and `fly` takes many such intervals by the same call: the simulation flies the steps between
+    the observers that read its state, bit for bit as `step` takes them one by one.
+
     Parameters
     ----------
     tolerance : float
@@ -273,8 +278,8 @@ class AdaptiveLeapfrog(Integrator):
         # An interval after one that met a contact likely meets one too (a gas): it is not
         # tried whole, which would cost its substeps up to the contact twice.
         tried = flight is not None and now != refused and not self.met_contact
-        if tried and self._fly(typing.cast(_SmoothFlight, flight), particles, field, now, 0, dt,
-                               _ONE):  # fmt: skip
+        if tried and self._intervals(typing.cast(_SmoothFlight, flight), particles, field, now,
+                                     0, dt, _ONE):  # fmt: skip
             return  # the interval met no contact: compiled whole
         start = _Snapshot(particles, tally)
         # The energy the substeps' rate is judged against: the interval's one read of the
@@ -319,8 +324,8 @@ class AdaptiveLeapfrog(Integrator):
         return self._flight
 
     def flies(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
-        """Whether `fly` may take steps here: forces that kick, all direct pair sums, in a
-        small scene (`_SmoothFlight.of`)."""
+        """Whether `fly` may take steps here: one force, a direct pair sum, in a small scene
+        (`_SmoothFlight.of`)."""
         return field.kicks and self._flight_for(particles, vessel, field) is not None
 
     def fly(
@@ -339,21 +344,14 @@ class AdaptiveLeapfrog(Integrator):
         if self.met_contact or not self.flies(particles, vessel, field):
             return 0
         flight = typing.cast(_SmoothFlight, self._flight)
-        flown = self._fly(flight, particles, field, origin, elapsed, dt, record)
+        flown = self._intervals(flight, particles, field, origin, elapsed, dt, record)
         if flown < record.shape[0]:  # `step` takes that interval next: it need not try again
             self._refused = origin + (elapsed + flown) * dt
         return flown
 
-    def _fly(
-        self,
-        flight: _SmoothFlight,
-        particles: Particles,
-        field: ForceField,
-        origin: float,
-        elapsed: int,
-        dt: float,
-        record: FloatArray,
-    ) -> int:
+    def _intervals(self, flight: _SmoothFlight, particles: Particles, field: ForceField,
+                   origin: float, elapsed: int, dt: float, record: FloatArray) -> int:  # fmt: skip
+        """`_SmoothFlight.intervals` from the substep count kept, which it updates."""
         flown, self.substeps = flight.intervals(
             particles, field, origin, elapsed, dt, self.substeps, self.tolerance, record
         )
