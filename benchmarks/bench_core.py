@@ -192,12 +192,18 @@ def seed_scene_costs() -> list[dict[str, Any]]:
     ]
 
 
-def _scene_seconds(name: str, duration: float) -> float:
-    """Wall seconds of a fresh preset run for ``duration`` simulated seconds."""
-    sim = cd.load(name)
-    start = time.perf_counter()
-    sim.run(time=duration)
-    return time.perf_counter() - start
+def _scene_seconds(name: str, duration: float, least: float = 0.5) -> float:
+    """Wall seconds of a fresh preset run for ``duration`` simulated seconds: the mean of as
+    many runs as take ``least`` seconds in all (a run of a few milliseconds alone is at the
+    mercy of the scheduler's time slices when other processes keep the cores busy)."""
+    runs, wall = 0, 0.0
+    while wall < least:
+        sim = cd.load(name)
+        start = time.perf_counter()
+        sim.run(time=duration)
+        wall += time.perf_counter() - start
+        runs += 1
+    return wall / runs
 
 
 # VmHWM, not ru_maxrss: a child's ru_maxrss starts from its parent's at the fork. RssAnon and
