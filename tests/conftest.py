@@ -1,20 +1,9 @@
-"""Shared fixtures: small random hard-disk systems."""
+"""Shared fixtures: the random generator of the tests (shared helpers live in lattices.py)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-
-
-def jittered_lattice(n_side: int, width: float, radius_max: float, rng: np.random.Generator):
-    """Centres on an n_side x n_side lattice, each moved at random within its own lattice cell so
-    that no two disks of radius <= radius_max overlap and all lie inside the box."""
-    spacing = width / n_side
-    room = 0.5 * spacing - radius_max
-    assert room > 0
-    grid = (np.arange(n_side) + 0.5) * spacing - width / 2
-    centres = np.array([(x, y) for y in grid for x in grid])
-    return centres + rng.uniform(-room, room, centres.shape)
 
 
 @pytest.fixture

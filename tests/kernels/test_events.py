@@ -8,7 +8,7 @@ import pytest
 from collidium import Box, Circle, Gravity, Particles, Simulation, collisions
 from collidium.kernels import cells, events, reference
 from collidium.kernels.events import contact_delay
-from conftest import jittered_lattice
+from lattices import jittered_lattice
 
 
 def test_contact_delay_head_on():

@@ -9,7 +9,7 @@ from matplotlib.figure import Figure
 import collidium as cd
 from collidium.observers import Thermo
 from collidium.theory import hard_disk_compressibility, hard_disk_virial_series
-from conftest import jittered_lattice
+from lattices import jittered_lattice
 
 
 def hard_disk_fluid(packing, boundary="periodic", n_side=30, radius=0.5, seed=1):
