@@ -239,24 +239,24 @@ class AdaptiveLeapfrog(Integrator):
         #: Regular substeps the next interval starts with (it may take more).
         self.substeps = 1
         self._flight: _SmoothFlight | None = None
-        #: Whether the last interval met a contact under forces (`step` then takes the next in
-        #: Python at once, as `fly` leaves it).
-        self.met_contact = False
-        #: The start (s) of the interval `fly` could not take, which `step` takes next.
-        self._refused: float | None = None
+        #: Whether `step` takes the next interval in Python at once, not tried whole: the last
+        #: met a contact under forces (in a gas the next likely meets one too, and a try would
+        #: cost its substeps up to the contact twice), or `fly` found that it meets one.
+        self.next_in_python = False
 
     def state(self) -> dict[str, np.ndarray]:
-        """The substep count the next interval starts with, and whether the last met a
-        contact."""
+        """The substep count the next interval starts with, and whether it is taken in Python
+        at once."""
         return {
             "substeps": np.array([self.substeps], dtype=np.int64),
-            "met_contact": np.array([self.met_contact]),
+            "next_in_python": np.array([self.next_in_python]),
         }
 
     def load_state(self, arrays: dict[str, np.ndarray]) -> None:
         """Take back what `state` returned (a missing count starts at 1)."""
         self.substeps = int(arrays["substeps"][0]) if "substeps" in arrays else 1
-        self.met_contact = bool(arrays["met_contact"][0]) if "met_contact" in arrays else False
+        python = arrays.get("next_in_python")
+        self.next_in_python = False if python is None else bool(python[0])
 
     def needed(self, rate2: float, dt: float) -> int:
         """The fewest substeps, a power of two up to `MAX_SUBSTEPS`, that keep ``dt / n`` within
@@ -274,10 +274,7 @@ class AdaptiveLeapfrog(Integrator):
         tally: Tally,
     ) -> None:
         flight = self._flight_for(particles, vessel, field)
-        refused, self._refused = self._refused, None
-        # An interval after one that met a contact likely meets one too (a gas): it is not
-        # tried whole, which would cost its substeps up to the contact twice.
-        tried = flight is not None and now != refused and not self.met_contact
+        tried = flight is not None and not self.next_in_python
         if tried and self._intervals(typing.cast(_SmoothFlight, flight), particles, field, now,
                                      0, dt, _ONE):  # fmt: skip
             return  # the interval met no contact: compiled whole
@@ -300,7 +297,7 @@ class AdaptiveLeapfrog(Integrator):
         n = max(self.substeps, self.needed(rate2, dt))
         while True:
             try:
-                fastest, self.met_contact = self._interval(
+                fastest, self.next_in_python = self._interval(
                     particles, vessel, field, drift, flight, now, dt, tally, n, rate2, total
                 )
             except SimulationError:  # any stop inside the interval leaves the state it began from
@@ -325,8 +322,12 @@ class AdaptiveLeapfrog(Integrator):
 
     def flies(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
         """Whether `fly` may take steps here: one force, a direct pair sum, in a small scene
-        (`_SmoothFlight.of`)."""
-        return field.kicks and self._flight_for(particles, vessel, field) is not None
+        (`_SmoothFlight.of`), and a next interval not left to Python."""
+        return (
+            not self.next_in_python
+            and field.kicks
+            and self._flight_for(particles, vessel, field) is not None
+        )
 
     def fly(
         self,
@@ -341,12 +342,13 @@ class AdaptiveLeapfrog(Integrator):
         """Whole intervals that meet no contact, compiled (`Integrator.fly`,
         `collidium.kernels.substeps.smooth_intervals`): `step` takes each such interval by the
         same call, so both give the same bits."""
-        if self.met_contact or not self.flies(particles, vessel, field):
+        if not self.flies(particles, vessel, field):
             return 0
         flight = typing.cast(_SmoothFlight, self._flight)
         flown = self._intervals(flight, particles, field, origin, elapsed, dt, record)
-        if flown < record.shape[0]:  # `step` takes that interval next: it need not try again
-            self._refused = origin + (elapsed + flown) * dt
+        # The interval left meets a contact (or too many substeps, or a value not finite):
+        # `step` takes it next, and need not try it again.
+        self.next_in_python = flown < record.shape[0]
         return flown
 
     def _intervals(self, flight: _SmoothFlight, particles: Particles, field: ForceField,

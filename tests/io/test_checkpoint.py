@@ -185,10 +185,10 @@ def test_a_run_saved_just_after_a_contact_under_forces_resumes_bitwise(tmp_path)
     integrator takes the next interval in Python rather than trying it whole, and so does the
     resumed run, which ends bit for bit as the uninterrupted one."""
     first = cd.load("charged-opposite")
-    while not first._integrator.met_contact:
+    while not first._integrator.next_in_python:
         first.run(steps=1)
     first.save(tmp_path / "run.ckpt")
     whole = cd.load("charged-opposite").run(steps=first.steps + 100)
     resumed = cd.restore(tmp_path / "run.ckpt")
-    assert resumed._integrator.met_contact
+    assert resumed._integrator.next_in_python
     assert_same_run(whole, resumed.run(steps=100))
