@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import collidium as cd
-from collidium.kernels.cells import first_overlap, grid_shape
+from collidium.collisions import ExactCollisions
+from collidium.kernels.cells import WINDOW_FROM, first_overlap, grid_shape
 from collidium.observers import Every
 
 
@@ -391,6 +392,89 @@ def test_steps_flown_in_one_call_are_bitwise_those_taken_one_by_one(name, time):
         np.testing.assert_array_equal(getattr(ours[2], column), getattr(theirs[2], column))
 
 
+def _spreading() -> cd.Simulation:
+    """Disks that spread out of the exact engine's cell window (which then covers a part of the
+    vessel alone), so that its queue is built again now and then."""
+    rng = np.random.default_rng(1)
+    n = WINDOW_FROM
+    particles = cd.Particles(rng.uniform(-5, 5, (n, 2)), rng.uniform(-50, 50, (n, 2)),
+                             radius=0.001)  # fmt: skip
+    return cd.Simulation(cd.Box(400.0, 400.0), particles, dt=0.01)
+
+
+@pytest.mark.parametrize(
+    ("scene", "time"),
+    [("gas", 2.0), ("pool-break", 0.5), ("circle-gas", 1.0), ("heat-flow", 1.0),
+     ("granular", 1.0), ("effusion", 1.0), (_spreading, 2.0)],
+)  # fmt: skip
+def test_exact_steps_flown_without_forces_are_bitwise_those_taken_one_by_one(
+    monkeypatch, scene, time
+):
+    """Without forces the exact engine flies the steps between the observers that read the
+    state in one compiled call: the run ends bit for bit as one whose observer reads every step,
+    with the same events and queue builds, and the observers that take what a flight records
+    measure bit for bit the same, with walls that give heat (heat-flow), inelastic collisions
+    (granular), segments (effusion) and disks that leave the engine's cell window."""
+    flown_steps = []
+    fly = ExactCollisions.fly
+
+    def counted(self, *args):
+        flown = fly(self, *args)
+        flown_steps.append(flown)
+        return flown
+
+    monkeypatch.setattr(ExactCollisions, "fly", counted)
+    runs = []
+    for reader in (StateReader(Every(250)), StateReader(Every(1))):
+        sim = cd.load(scene) if isinstance(scene, str) else scene()
+        measured = [cd.observers.EnergyDrift(), cd.observers.EnergyDrift(7),
+                    cd.observers.EnergySeries(), cd.observers.Thermo(3),
+                    cd.observers.CollisionRate(3)]  # fmt: skip
+        # Not the presets' own (a temperature profile, the effusion's counts): they read the
+        # particles at every step.
+        sim.observers = [*measured, reader]
+        sim.run(time=time)
+        runs.append((sim, measured, sum(flown_steps)))
+        flown_steps.clear()
+    (flown, ours, steps_flown), (stepped, theirs, none) = runs
+    assert steps_flown >= flown.steps - 10 and none == 0
+    np.testing.assert_array_equal(flown.particles.position, stepped.particles.position)
+    np.testing.assert_array_equal(flown.particles.velocity, stepped.particles.velocity)
+    assert flown.counters == stepped.counters
+    for name in ("events", "rebuilds"):
+        assert getattr(flown._drift, name) == getattr(stepped._drift, name)
+    for a, b in zip(ours, theirs, strict=True):
+        assert a.samples == b.samples
+        assert a.summary() == b.summary() or _same_with_nan(a.summary(), b.summary())
+    for column in ("time", "kinetic", "potential", "total_speed", "momentum"):
+        np.testing.assert_array_equal(getattr(ours[2], column), getattr(theirs[2], column))
+
+
+def test_a_flight_stops_at_the_step_the_audit_refuses(monkeypatch):
+    """A disk outside the vessel (here one made smaller for the audit alone) stops a flown run
+    at the same step, with the same words, as a run stepped one by one, and the observers that
+    took the flight's record saw the same steps before it."""
+    probe = cd.load("gas")
+    reach = 0.0
+    for _ in range(3):  # the farthest any disk reaches in the first two steps: later is a flight
+        p = probe.particles
+        reach = max(reach, float(np.max(np.abs(p.position) + p.radius[:, None])))
+        probe.run(steps=1)
+    code, _, _, slack, periodic = probe.container.audit_arguments()
+    monkeypatch.setattr(cd.Box, "audit_arguments", lambda self: (code, reach, reach, slack,
+                                                                periodic))  # fmt: skip
+    outcomes = []
+    for reader in (StateReader(Every(250)), StateReader(Every(1))):
+        sim = cd.load("gas")
+        series = cd.observers.EnergySeries()
+        sim.observers += [series, reader]
+        with pytest.raises(cd.SimulationError, match="left the vessel") as stopped:
+            sim.run(steps=100)
+        outcomes.append((str(stopped.value), sim.steps, series.time.tolist()))
+    assert outcomes[0] == outcomes[1]
+    assert outcomes[0][1] >= 3
+
+
 def _same_with_nan(a: dict, b: dict) -> bool:
     """Whether two summaries are equal, NaN equal to NaN."""
     return a.keys() == b.keys() and all(
@@ -411,7 +495,7 @@ def test_small_scenes_fly_between_the_observers_that_read_the_state(monkeypatch)
 
     def counted(self, *args):
         flown = fly(self, *args)
-        calls.append((args[-1].shape[0], flown))
+        calls.append((args[-1].values.shape[0], flown))
         return flown
 
     monkeypatch.setattr(AdaptiveLeapfrog, "fly", counted)

@@ -22,10 +22,11 @@ from typing import Literal, Protocol
 import numpy as np
 
 from collidium.errors import SimulationError
-from collidium.kernels import events, stepper
+from collidium.kernels import event_flights, events, stepper
 from collidium.kernels.cells import bounding_box, event_grid_shape, grid_window, window_sides
+from collidium.kernels.substeps import RECORD
 from collidium.kernels.vessels import piston as piston_kernels
-from collidium.state import FloatArray, IntArray, Particles, as_given
+from collidium.state import FloatArray, IntArray, Particles, as_given, writable
 from collidium.vessels import Vessel
 from collidium.vessels.walls import wall_axis
 
@@ -87,6 +88,44 @@ class Tally:
 
 
 @dataclass(frozen=True)
+class FlightRecord:
+    """What a flight (`collidium.integrators.Integrator.fly`) records at the end of each step it
+    takes, K rows: what the observers that read no more would have read then.
+
+    Attributes
+    ----------
+    values : ndarray, shape (K, len(collidium.kernels.substeps.RECORD))
+        The kinetic and potential energy and the pair virial (J), the momentum (kg m/s) and the
+        sum of the speeds (m/s), as `collidium.simulation.Simulation` sums them.
+    counts, impulse, heat : ndarray, shape (K, 1 + W)
+        The `Tally`'s.
+    """
+
+    values: FloatArray
+    counts: IntArray
+    impulse: FloatArray
+    heat: FloatArray
+
+    @classmethod
+    def empty(cls, steps: int, tally: Tally) -> FlightRecord:
+        """Rows for ``steps`` steps of a vessel with ``tally``'s walls, not yet written."""
+        size = tally.counts.shape[0]
+        return cls(
+            np.empty((steps, len(RECORD))),
+            np.empty((steps, size), dtype=np.int64),
+            np.empty((steps, size)),
+            np.empty((steps, size)),
+        )
+
+    def tally_of_now(self, steps: int, tally: Tally) -> None:
+        """The first ``steps`` rows of the tallies, those of now: a flight that met no wall and
+        no disk."""
+        self.counts[:steps] = tally.counts
+        self.impulse[:steps] = tally.impulse
+        self.heat[:steps] = tally.heat
+
+
+@dataclass(frozen=True)
 class Contact:
     """A collision or wall hit at which a drift halted, before processing it.
 
@@ -145,6 +184,26 @@ class Drift(Protocol):
         mode when nothing halts it, return None.
         """
 
+    def flies(self, particles: Particles, tally: Tally) -> bool:
+        """Whether `fly` may take steps without forces now."""
+
+    def fly(
+        self,
+        particles: Particles,
+        vessel: Vessel,
+        origin: float,
+        elapsed: int,
+        dt: float,
+        tally: Tally,
+        record: FlightRecord,
+    ) -> int:
+        """Drift up to ``len(record)`` steps of ``dt`` (s) without forces in one compiled call,
+        bit for bit as `drift` and the run loop would take them one by one, up to the first that
+        it cannot take; returns how many it took, each recorded in ``record``. Step k starts at
+        ``origin + (elapsed + k) dt``, the simulation's clock. A step that leaves a particle
+        outside the vessel or a value not finite ends the flight, taken, for the run loop's
+        audit to report."""
+
     def state(self) -> dict[str, np.ndarray]:
         """Arrays a checkpoint needs to continue bit for bit (empty if the mode keeps none)."""
 
@@ -200,12 +259,18 @@ def _refuse_runaway(
     velocity = particles.velocity
     # Reductions only: an (N, 2) temporary would add 16 bytes per disk to the peak memory.
     speed = max(float(velocity.max()), -float(velocity.min())) + float(np.abs(fall).max()) * dt
-    if speed * dt > MAX_CROSSINGS_PER_DRIFT * float(vessel.size.min()):
+    if speed * dt > _runaway_reach(vessel):
         fastest = int(np.abs(velocity).max(axis=1).argmax())
         raise SimulationError(
             f"particle {fastest} moves at {speed:.3g} m/s, over {MAX_CROSSINGS_PER_DRIFT:.0g} "
             "vessel widths per step: the state has run away; try a smaller dt or softening"
         )
+
+
+def _runaway_reach(vessel: Vessel) -> float:
+    """The distance (m) past which a drift's largest velocity component times dt counts as
+    runaway (`MAX_CROSSINGS_PER_DRIFT`)."""
+    return MAX_CROSSINGS_PER_DRIFT * float(vessel.size.min())
 
 
 class _Stateless:
@@ -223,6 +288,23 @@ class _Stateless:
 
     def forget(self) -> None:
         """Nothing kept."""
+
+    def flies(self, particles: Particles, tally: Tally) -> bool:
+        """Never: each step is its own call (`Drift.flies`)."""
+        return False
+
+    def fly(
+        self,
+        particles: Particles,
+        vessel: Vessel,
+        origin: float,
+        elapsed: int,
+        dt: float,
+        tally: Tally,
+        record: FlightRecord,
+    ) -> int:
+        """No steps (`Drift.fly`)."""
+        return 0
 
 
 class NoCollisions(_Stateless):
@@ -552,6 +634,54 @@ class ExactCollisions:
             # Disks have spread out of the cells' window: a larger one at the next drift.
             self._spare, self._state = self._state, None
         return None
+
+    def flies(self, particles: Particles, tally: Tally) -> bool:
+        """Whether `fly` may take steps now: the queue is built, nobody changed the particles
+        since it wrote them, and the vessel has no piston (`Drift.flies`)."""
+        return tally.piston.size == 0 and self._is_current(particles, tally.piston, _NO_FALL)
+
+    def fly(
+        self,
+        particles: Particles,
+        vessel: Vessel,
+        origin: float,
+        elapsed: int,
+        dt: float,
+        tally: Tally,
+        record: FlightRecord,
+    ) -> int:
+        """Steps without forces in one compiled call (`Drift.fly`,
+        `collidium.kernels.event_flights.event_intervals`)."""
+        if not self.flies(particles, tally):
+            return 0
+        s = self._state
+        assert s is not None
+        before = (tally.counts.copy(), tally.impulse.copy(), tally.heat.copy())
+        self._halt[events.HALT_AFTER] = math.inf
+        p = particles
+        taken, processed, ending = event_flights.event_intervals(
+            origin, elapsed, dt, record.values.shape[0], s["body"], p.image, s["geometry"],
+            s["grid"], s["head"], s["next"], s["event"], s["keys"], s["items"], tally.counts,
+            tally.impulse, _NO_ACCELERATION, max(1, self.sort_interval * p.n), self._halt,
+            vessel.wall_table(), tally.heat, vessel.segments(), s["piston"], p.position,
+            p.velocity, writable(p.mass), writable(p.radius), _runaway_reach(vessel),
+            *vessel.audit_arguments(), bool(s["grid"][2]) or _window_is_vessel(s["geometry"],
+            s["grid"]), record.values, record.counts, record.impulse, record.heat,
+        )  # fmt: skip
+        self.events += processed
+        if taken:
+            self._synced_at = origin + (elapsed + taken - 1) * dt + dt  # as `drift` adds them
+        if ending == event_flights.OUT_OF_WINDOW:
+            self._spare, self._state = self._state, None  # as `drift`: a larger window next
+        elif ending < 0:
+            # Time stopped advancing in the step after those taken: the drift takes it again
+            # from the particles as the last step wrote them, and says where it stopped.
+            self._state = None
+            rows = (record.counts, record.impulse, record.heat)
+            kept = before if taken == 0 else tuple(row[taken - 1] for row in rows)
+            for now, then in zip((tally.counts, tally.impulse, tally.heat), kept, strict=True):
+                now[...] = then
+        return int(taken)
 
 
 def _window_is_vessel(geometry: FloatArray, grid: np.ndarray) -> bool:

@@ -28,7 +28,7 @@ from typing import Literal
 
 import numpy as np
 
-from collidium.collisions import Contact, Drift, Tally
+from collidium.collisions import Contact, Drift, FlightRecord, Tally
 from collidium.errors import SimulationError
 from collidium.forces import ForceField
 from collidium.kernels import substeps, sums
@@ -122,27 +122,34 @@ class Integrator:
     ) -> None:
         raise NotImplementedError
 
-    def flies(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
-        """Whether `fly` may take steps here (none by default)."""
-        return False
+    def flies(
+        self, particles: Particles, vessel: Vessel, field: ForceField, drift: Drift, tally: Tally
+    ) -> bool:
+        """Whether `fly` may take steps here: without forces where the drift mode flies
+        (`Drift.flies`), with forces where the integrator does (`_flies_with_forces`)."""
+        if field.kicks:
+            return self._flies_with_forces(particles, vessel, field)
+        return not field.active and drift.flies(particles, tally)
 
     def fly(
         self,
         particles: Particles,
         vessel: Vessel,
         field: ForceField,
+        drift: Drift,
         origin: float,
         elapsed: int,
         dt: float,
-        record: FloatArray,
+        tally: Tally,
+        record: FlightRecord,
     ) -> int:
-        """Take up to ``len(record)`` steps of ``dt`` (s) in one compiled call, as `step` would
-        take them one by one, bit for bit, up to the first that this call cannot take (which
-        is left as it began); returns how many it took.
+        """Take up to ``len(record.values)`` steps of ``dt`` (s) in one compiled call, as `step`
+        would take them one by one, bit for bit, up to the first that this call cannot take
+        (which is left as it began); returns how many it took.
 
         Parameters
         ----------
-        particles, vessel, field
+        particles, vessel, field, drift, tally
             As in `step`.
         origin : float
             The simulation's clock origin, s: step k starts at ``origin + (elapsed + k) dt``.
@@ -150,11 +157,32 @@ class Integrator:
             Steps from the clock's origin to the first step's start.
         dt : float
             The reporting interval, s.
-        record : ndarray, shape (K, len(collidium.kernels.substeps.RECORD))
-            Output: the energies, virial, momentum and total speed after each step taken
-            (`collidium.kernels.substeps.RECORD`), as `collidium.simulation.Simulation` gives
-            them.
+        record : FlightRecord
+            Output: what the observers read at the end of each step taken.
         """
+        if field.kicks:
+            return self._fly_with_forces(particles, vessel, field, origin, elapsed, dt, tally,
+                                         record)  # fmt: skip
+        if field.active:  # a fall the drift carries: it has a potential energy
+            return 0
+        return drift.fly(particles, vessel, origin, elapsed, dt, tally, record)
+
+    def _flies_with_forces(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
+        """Whether `_fly_with_forces` may take steps here (none by default)."""
+        return False
+
+    def _fly_with_forces(
+        self,
+        particles: Particles,
+        vessel: Vessel,
+        field: ForceField,
+        origin: float,
+        elapsed: int,
+        dt: float,
+        tally: Tally,
+        record: FlightRecord,
+    ) -> int:
+        """`fly` under forces that kick (no steps by default)."""
         return 0
 
     def state(self) -> dict[str, np.ndarray]:
@@ -320,16 +348,12 @@ class AdaptiveLeapfrog(Integrator):
             self._flight = _SmoothFlight.of(particles, vessel, field)
         return self._flight
 
-    def flies(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
-        """Whether `fly` may take steps here: one force, a direct pair sum, in a small scene
-        (`_SmoothFlight.of`), and a next interval not left to Python."""
-        return (
-            not self.next_in_python
-            and field.kicks
-            and self._flight_for(particles, vessel, field) is not None
-        )
+    def _flies_with_forces(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
+        """Whether `_fly_with_forces` may take steps here: one force, a direct pair sum, in a
+        small scene (`_SmoothFlight.of`), and a next interval not left to Python."""
+        return not self.next_in_python and self._flight_for(particles, vessel, field) is not None
 
-    def fly(
+    def _fly_with_forces(
         self,
         particles: Particles,
         vessel: Vessel,
@@ -337,18 +361,21 @@ class AdaptiveLeapfrog(Integrator):
         origin: float,
         elapsed: int,
         dt: float,
-        record: FloatArray,
+        tally: Tally,
+        record: FlightRecord,
     ) -> int:
-        """Whole intervals that meet no contact, compiled (`Integrator.fly`,
-        `collidium.kernels.substeps.smooth_intervals`): `step` takes each such interval by the
-        same call, so both give the same bits."""
-        if not self.flies(particles, vessel, field):
+        """Whole intervals that meet no contact, compiled
+        (`collidium.kernels.substeps.smooth_intervals`): `step` takes each such interval by the
+        same call, so both give the same bits. They touch no wall and no disk: the tallies are
+        those of now."""
+        if not self._flies_with_forces(particles, vessel, field):
             return 0
         flight = typing.cast(_SmoothFlight, self._flight)
-        flown = self._intervals(flight, particles, field, origin, elapsed, dt, record)
+        flown = self._intervals(flight, particles, field, origin, elapsed, dt, record.values)
+        record.tally_of_now(flown, tally)
         # The interval left meets a contact (or too many substeps, or a value not finite):
         # `step` takes it next, and need not try it again.
-        self.next_in_python = flown < record.shape[0]
+        self.next_in_python = flown < record.values.shape[0]
         return flown
 
     def _intervals(self, flight: _SmoothFlight, particles: Particles, field: ForceField,

@@ -11,10 +11,11 @@ Run loop, one step of length dt (the reporting interval):
 3. audit: a NaN/infinity or a particle outside the vessel stops the run with `SimulationError`;
 4. observers whose trigger fires (``trigger(sim)``) are updated.
 
-Where the integrator can (a small scene under a direct pair force: `Integrator.fly`), the steps
-before the next observer that reads the state are taken in one compiled call, bit for bit as one
-by one; observers that read no more than the energies, virial, momentum and total speed
-(``take_flown``: `collidium.observers.Flown`) get those of each of their steps from it.
+Where the integrator can (`Integrator.fly`: exact collisions without forces, or a small scene
+under a direct pair force), the steps before the next observer that reads the state are taken in
+one compiled call, bit for bit as one by one; observers that read no more than the energies,
+virial, momentum, total speed and tallies (``take_flown``: `collidium.observers.Flown`) get
+those of each of their steps from it.
 """
 
 from __future__ import annotations
@@ -30,10 +31,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from collidium.collisions import COLLISION_MODES, CollisionMode, Tally, make_drift
+from collidium.collisions import COLLISION_MODES, CollisionMode, FlightRecord, Tally, make_drift
 from collidium.errors import InputError, SimulationError
 from collidium.forces import Force, ForceField, PositionForce, force_from_dict
-from collidium.forces.pair import writable
 from collidium.integrators import (
     DEFAULT_TOLERANCE,
     INTEGRATORS,
@@ -45,10 +45,9 @@ from collidium.io.checkpoint import read_checkpoint, saved_vessel, write_checkpo
 from collidium.kernels import sums
 from collidium.kernels.audit import first_invalid
 from collidium.kernels.cells import first_overlap, grid_shape, grid_window, window_sides
-from collidium.kernels.substeps import RECORD
 from collidium.observers.base import Every, Flown, Observer
-from collidium.state import PROPERTIES, FloatArray, Particles, as_given
-from collidium.vessels import OUTSIDE_TOLERANCE, Vessel, vessel_from_dict
+from collidium.state import PROPERTIES, FloatArray, IntArray, Particles, as_given, writable
+from collidium.vessels import Vessel, vessel_from_dict
 from collidium.vessels.walls import check_restitution
 
 #: Most steps one `Simulation.run` call accepts (a guard against a mistyped time or dt).
@@ -429,7 +428,9 @@ class Simulation:
                 return 1
             if not hasattr(observer, "take_flown"):
                 run = min(run, trigger.period - self.steps % trigger.period)
-        if run > 1 and not self._integrator.flies(self.particles, self.container, self._field):
+        if run > 1 and not self._integrator.flies(
+            self.particles, self.container, self._field, self._drift, self.tally
+        ):
             return 1
         return run
 
@@ -437,28 +438,44 @@ class Simulation:
         """Up to ``run`` steps in one compiled call; the observers that read no more than its
         record get what they would have read on each step they fire on, and after the last
         step, if it was taken, the others fire as after any step. Returns the steps taken."""
-        record = np.empty((run, len(RECORD)))
+        record = FlightRecord.empty(run, self.tally)
         first = self.steps
         origin, start = self._time_origin
         flown = self._integrator.fly(
-            self.particles, self.container, self._field, origin, first - start, self.dt, record
-        )
+            self.particles, self.container, self._field, self._drift, origin, first - start,
+            self.dt, self.tally, record,
+        )  # fmt: skip
         if flown == 0:
             return 0
         self.steps += flown
-        self._audit()
         steps = np.arange(first + 1, self.steps + 1)
-        times = origin + (steps - start) * self.dt  # as `time` counts them
-        for observer in self.observers:
-            if hasattr(observer, "take_flown"):
-                at = steps % typing.cast(Every, observer.trigger).period == 0
-                if at.any():
-                    observer.take_flown(self, Flown(times[at], *record[:flown][at].T))
+        times = np.asarray(origin + (steps - start) * self.dt, dtype=np.float64)  # as `time`
+        # As `_step`: the observers fire after each step that passed the audit. A flight ends at
+        # the first step that fails it.
+        self._take_flown(steps[:-1], times[:-1], record)
+        self._audit()
+        self._take_flown(steps[-1:], times[-1:], record, flown - 1)
         if flown == run:
             for observer in self.observers:
                 if not hasattr(observer, "take_flown") and observer.trigger(self):
                     observer.update(self)
         return flown
+
+    def _take_flown(
+        self, steps: IntArray, times: FloatArray, record: FlightRecord, first: int = 0
+    ) -> None:
+        """Hand the observers that take a flight's record (``take_flown``) its rows from
+        ``first`` on, of the ``steps`` at ``times`` (s), at those their trigger fires on."""
+        rows = slice(first, first + steps.shape[0])
+        for observer in self.observers:
+            if hasattr(observer, "take_flown"):
+                at = steps % typing.cast(Every, observer.trigger).period == 0
+                if at.any():
+                    kinetic, potential, virial, px, py, speed = record.values[rows][at].T
+                    flown = Flown(times[at], kinetic, potential, virial, px, py, speed,
+                                  record.counts[rows][at], record.impulse[rows][at],
+                                  record.heat[rows][at])  # fmt: skip
+                    observer.take_flown(self, flown)
 
     def _step(self) -> None:
         try:
@@ -478,8 +495,7 @@ class Simulation:
         p = self.particles
         vessel = self.container
         index, reason = first_invalid(
-            p.position, p.velocity, p.radius, vessel.shape_code,
-            *vessel.audit_limits(OUTSIDE_TOLERANCE), vessel.periodic, vessel.segments(),
+            p.position, p.velocity, p.radius, *vessel.audit_arguments(), vessel.segments(),
         )  # fmt: skip
         if index < 0 and self.tally.piston.size and self.escaped():
             reason = 2

@@ -203,6 +203,16 @@ class Particles:
 PROPERTIES = ("mass", "radius", "charge")
 
 
+def writable(values: FloatArray) -> FloatArray:
+    """``values`` (N,) as a contiguous writable array, copied if it is not one: a value all
+    particles share is a read-only view of stride 0 (`collidium.state.Particles`), another type
+    to numba, which would compile a kernel a second time for it: a copy costs O(N), less than
+    any kernel that takes it."""
+    if values.flags.c_contiguous and values.flags.writeable:
+        return values
+    return np.array(values)
+
+
 def as_given(values: FloatArray) -> float | FloatArray:
     """A property of `Particles` as it was given: the shared value if it is stored once, else the
     per-particle array (to copy or save it without spreading a shared value over N entries)."""

@@ -16,7 +16,7 @@ from collidium.errors import InputError
 from collidium.forces.base import check_at_least
 from collidium.kernels import tree
 from collidium.kernels.pairwise import inverse_distance_direct, inverse_distance_stiffness
-from collidium.state import FloatArray, Particles
+from collidium.state import FloatArray, Particles, writable
 from collidium.vessels import Vessel
 
 SumMethod = Literal["auto", "direct", "tree"]
@@ -58,16 +58,6 @@ def check_vessel(name: str, method: str, vessel: Vessel) -> None:
             f"forces.{name}.method",
             "the tree cannot sum a periodic vessel (minimum image); use 'direct' or 'auto'",
         )
-
-
-def writable(values: FloatArray) -> FloatArray:
-    """``values`` (N,) as a contiguous writable array, copied if it is not one: a value all
-    particles share is a read-only view of stride 0 (`collidium.state.Particles`), another type
-    to numba, which would compile the pair kernels a second time for it (O(N) against their
-    O(N log N) or O(N^2))."""
-    if values.flags.c_contiguous and values.flags.writeable:
-        return values
-    return np.array(values)
 
 
 def uses_tree(method: str, particles: Particles, vessel: Vessel) -> bool:

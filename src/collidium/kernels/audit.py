@@ -37,7 +37,7 @@ def first_invalid(
     shape : int
         The vessel's shape code (`collidium.kernels.vessels`).
     limit_x, limit_y, slack : float
-        The shape's limits with their round-off allowance (`Vessel.audit_limits`): the box's
+        The shape's limits with their round-off allowance (`Vessel.audit_arguments`): the box's
         half sides, the circle's radius twice (m); how much closer than its radius a disk may
         come to a segment (m).
     periodic : bool
@@ -50,7 +50,7 @@ def first_invalid(
     tuple of int
         ``(index, reason)``: reason 1 for non-finite, 2 for outside; ``(-1, 0)`` if all is well.
     """
-    audit = _in_chunks if position.shape[0] >= PARALLEL_FROM else _in_order
+    audit = _in_chunks if position.shape[0] >= PARALLEL_FROM else in_order
     index, reason = audit(
         position, velocity, radius, shape, limit_x, limit_y, slack, periodic, segments
     )
@@ -58,8 +58,8 @@ def first_invalid(
 
 
 @numba.njit(cache=True)
-def _in_order(position, velocity, radius, shape, limit_x, limit_y, slack, periodic, segments):
-    """`first_invalid` in one pass, particle by particle."""
+def in_order(position, velocity, radius, shape, limit_x, limit_y, slack, periodic, segments):
+    """`first_invalid` in one pass, particle by particle, compiled: ``(index, reason)``."""
     return _first_between(0, position.shape[0], position, velocity, radius, shape, limit_x,
                           limit_y, slack, periodic, segments)  # fmt: skip
 

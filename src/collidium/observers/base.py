@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol, Self, runtime_checkable
 
 from collidium.errors import InputError
-from collidium.state import FloatArray
+from collidium.state import FloatArray, IntArray
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -112,22 +112,25 @@ def as_trigger(trigger: Trigger | int | None) -> Trigger:
 
 @dataclass(frozen=True)
 class Flown:
-    """What a run records of the steps it flew in one compiled call (`Simulation.run`, a small
-    charged scene), at those an observer's trigger fired on. The rest of the state the
-    observers read (the tallies, the vessel) did not change in between: nothing touched a wall
-    or another disk. Arrays (K,), one value per step, as `Simulation` gives them.
+    """What a run records of the steps it flew in one compiled call (`Simulation.run`: exact
+    collisions without forces, or a small charged scene), at those an observer's trigger fired
+    on, as `Simulation` gives them at each. The vessel did not change in between (a flight
+    has no piston). Arrays of K rows, one per step.
 
     Attributes
     ----------
-    time : ndarray
+    time : ndarray, shape (K,)
         Simulated time in s.
-    kinetic, potential, virial : ndarray
+    kinetic, potential, virial : ndarray, shape (K,)
         Kinetic and potential energy and pair virial in J (`Simulation.energy`,
         `Simulation.virial`).
-    px, py : ndarray
+    px, py : ndarray, shape (K,)
         Total momentum in kg m/s.
-    total_speed : ndarray
+    total_speed : ndarray, shape (K,)
         Sum of the speeds in m/s.
+    counts, impulse, heat : ndarray, shape (K, 1 + W)
+        The tallies (`collidium.collisions.Tally`): collisions and wall hits, the collision
+        virial and the walls' impulses, the heat given.
     """
 
     time: FloatArray
@@ -137,6 +140,9 @@ class Flown:
     px: FloatArray
     py: FloatArray
     total_speed: FloatArray
+    counts: IntArray
+    impulse: FloatArray
+    heat: FloatArray
 
 
 @runtime_checkable
@@ -145,9 +151,9 @@ class Observer(Protocol):
     step on which ``trigger(sim)`` is true.
 
     An observer whose trigger is an `Every` and that reads no more than a `Flown` holds may
-    also have ``take_flown(sim, flown)``: a small charged scene then flies the steps between
-    the other observers' firings in one compiled call and hands it what it would have read at
-    each of its own (`EnergyDrift`, `EnergySeries`, `Thermo`, `CollisionRate` do)."""
+    also have ``take_flown(sim, flown)``: a run then flies the steps between the other
+    observers' firings in one compiled call where it can and hands it what it would have read
+    at each of its own (`EnergyDrift`, `EnergySeries`, `Thermo`, `CollisionRate` do)."""
 
     trigger: Trigger
 

@@ -43,10 +43,9 @@ class CollisionRate(Measurement):
 
     def take_flown(self, sim: Simulation, flown: Flown) -> None:
         """Samples of steps the run flew in one compiled call (`Flown`), as `update` after
-        each: nothing collided in between, so the counts are those of now."""
-        counts = sim.tally.counts.copy()
+        each."""
         self._time += flown.time.tolist()
-        self._counts += [counts] * flown.time.shape[0]
+        self._counts += list(flown.counts)
         self._mean_speed += (flown.total_speed / max(sim.particles.n, 1)).tolist()
         self.samples += flown.time.shape[0]
 

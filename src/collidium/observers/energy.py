@@ -211,10 +211,11 @@ class EnergyDrift(Measurement):
 
     def take_flown(self, sim: Simulation, flown: Flown) -> None:
         """Samples of steps the run flew in one compiled call (`Flown`): the same as `update`
-        after each, nothing having been given to the disks in between."""
-        given = _given(sim)
-        for total in (flown.kinetic + flown.potential).tolist():
-            self._take(total - given)
+        after each (no forces gave energy in between: a flight has none that do)."""
+        forces = sim.force_heat()
+        totals = (flown.kinetic + flown.potential).tolist()
+        for total, heat in zip(totals, flown.heat, strict=True):
+            self._take(total - given_energy(heat, forces))
         self.samples += flown.time.shape[0]
 
     def _take(self, conserved: float) -> None:
@@ -237,4 +238,12 @@ def conserved_energy(sim: Simulation, energy: Energy | None = None) -> float:
 
 def _given(sim: Simulation) -> float:
     """The energy the walls, inelastic collisions and velocity forces have given the disks, J."""
-    return float(sum(sim.wall_heat().values()) + sim.collision_heat() + sim.force_heat())
+    return given_energy(sim.tally.heat, sim.force_heat())
+
+
+def given_energy(heat: FloatArray, forces: float) -> float:
+    """The energy given to the disks, J, from a tally's ``heat`` (1 + W,) (the inelastic
+    collisions', then each wall's) and the velocity forces' (``forces``), summed as
+    `Simulation.wall_heat`, `Simulation.collision_heat` and `Simulation.force_heat` give them."""
+    walls = sum(float(value) for value in heat[1:])
+    return float(walls + float(heat[0]) + forces)

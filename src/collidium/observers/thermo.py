@@ -86,28 +86,28 @@ class Thermo(Measurement):
         self._time.append(sim.time)
         self._kT.append(sim.temperature())
         self._force_virial.append(sim.virial())
-        self._take_walls(sim, 1)
+        self._take_walls(sim, sim.tally.impulse[None].copy())
 
     def take_flown(self, sim: Simulation, flown: Flown) -> None:
         """Samples of steps the run flew in one compiled call (`Flown`), as `update` after
-        each: no wall was hit in between, so the walls' impulses are those of now."""
+        each: the vessel did not change in between."""
         n = sim.particles.n
         self._time += flown.time.tolist()
         self._kT += (flown.kinetic / n).tolist() if n else [float("nan")] * flown.time.shape[0]
         self._force_virial += flown.virial.tolist()
-        self._take_walls(sim, flown.time.shape[0])
+        self._take_walls(sim, flown.impulse)
         self.samples += flown.time.shape[0]
 
-    def _take_walls(self, sim: Simulation, samples: int) -> None:
-        """The walls' impulses, contact lengths and the area available now, ``samples`` times."""
+    def _take_walls(self, sim: Simulation, impulses: FloatArray) -> None:
+        """The walls' ``impulses`` (K, 1 + W) of K samples, with the contact lengths and the
+        area available now."""
         state = sim.piston()
         piston = None if state is None else state.position
-        impulse = sim.tally.impulse.copy()
         contact = sim.container.contact_lengths(self._radius, piston)
         area = sim.container.available_area(self._radius, piston)
-        self._impulse += [impulse] * samples
-        self._contact += [contact] * samples
-        self._area += [area] * samples
+        self._impulse += list(impulses)
+        self._contact += [contact] * impulses.shape[0]
+        self._area += [area] * impulses.shape[0]
 
     @property
     def contact(self) -> FloatArray:

@@ -294,11 +294,14 @@ class Vessel(ABC):
         """A circle's radius in m, for the kernels (NaN for shapes without one)."""
         return math.nan
 
-    def audit_limits(self, tolerance: float) -> tuple[float, float, float]:
-        """The limits (m) of the audit's outside test (`collidium.kernels.audit`) with a
-        relative round-off allowance ``tolerance``: the shape's two (`_shape_limits`) and the
-        allowance for segments."""
-        return *self._shape_limits(tolerance), tolerance * float(self.extent.max())
+    def audit_arguments(self) -> tuple[int, float, float, float, bool]:
+        """What the audit (`collidium.kernels.audit.first_invalid`) takes of the vessel before
+        its segments: the shape code, the limits (m) of the outside test with a relative
+        round-off allowance of `OUTSIDE_TOLERANCE` (the shape's two, `_shape_limits`, and the
+        allowance for segments), and whether it is periodic."""
+        tolerance = OUTSIDE_TOLERANCE
+        limits = *self._shape_limits(tolerance), tolerance * float(self.extent.max())
+        return self.shape_code, *limits, self.periodic
 
     @abstractmethod
     def _shape_limits(self, tolerance: float) -> tuple[float, float]:

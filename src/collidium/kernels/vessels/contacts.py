@@ -65,7 +65,7 @@ def touch(contact, x, y, vx, vy, r, shape, half_width, half_height, rim, table):
 @numba.njit(cache=True, inline="always")
 def reaches_outside(x, y, reach, shape, limit_x, limit_y, slack, table) -> bool:
     """Whether a disk at (x, y) reaching ``reach`` m from its centre passes the shape's limits
-    (`collidium.vessels.Vessel.audit_limits`, round-off allowance included) or comes closer than
+    (`collidium.vessels.Vessel.audit_arguments`, round-off allowance included) or comes closer than
     ``reach - slack`` to a segment."""
     if shape == CIRCLE:
         outside = circle.reaches_outside(x, y, reach, limit_x)

@@ -1,0 +1,123 @@
+"""Whole reporting intervals of the exact engine without forces, compiled.
+
+Without forces the exact engine's queue lives on from step to step (`collidium.kernels.events`),
+and a step of a small scene is a few microseconds of events inside some twenty of Python: the
+drift's checks, the run loop, the audit. `event_intervals` takes many steps in one call, each as
+`collidium.collisions.ExactCollisions.drift` and the run loop take one: the events up to the
+step's end (`events.run_events`), the particles written at it (`events.synchronise`) and audited
+(`collidium.kernels.audit.in_order`), and it records what the observers read at each step's end
+(`collidium.kernels.substeps.RECORD`, and the tallies), so that a run flies the steps between
+the observers that read more of its state. It stops where the drift or the run loop would do
+anything else: a speed that `collidium.collisions` refuses, a particle outside the vessel or a
+value not finite, disks spread out of the cells' window, or time that stops advancing.
+"""
+
+from __future__ import annotations
+
+import numba
+
+from collidium.kernels import events
+from collidium.kernels.audit import in_order
+from collidium.kernels.sums import kinetic_energy, momentum, total_speed
+
+#: How `event_intervals` ended: every interval taken; at an interval that the drift must take
+#: (its speeds are refused, or the audit fails after it: the interval counts as taken then);
+#: after an interval that left disks outside the cells' window (the queue must be built again).
+ALL, STOPPED, OUT_OF_WINDOW = range(3)
+
+
+@numba.njit(cache=True)
+def event_intervals(
+    origin, elapsed, dt, count, body, image, geometry, grid, head, next_, event, keys, items,
+    tally, impulse, acceleration, sort_every, halt, walls, heat, segments, piston, position,
+    velocity, mass, radius, reach, audit_shape, limit_x, limit_y, slack, periodic,
+    window_is_vessel, record, counts, impulses, heats,
+) -> tuple[int, int, int]:  # fmt: skip
+    """Up to ``count`` steps of ``dt`` (s) of the exact engine without forces, in place.
+
+    Step k runs from ``origin + (elapsed + k) dt`` (the simulation's clock) to the next.
+
+    Parameters
+    ----------
+    origin, elapsed, dt, count
+        The clock's origin (s), the steps from it to the first step's start, the step (s) and
+        the most steps to take (at most ``len(record)``).
+    body, image, geometry, grid, head, next_, event, keys, items, tally, impulse, acceleration,
+    sort_every, halt, walls, heat, segments, piston
+        As `events.run_events` takes them (``acceleration`` empty, ``halt`` never halting).
+    position, velocity : ndarray, shape (N, 2)
+        The particles' state (m, m/s), written at each step's end (`events.synchronise`).
+    mass, radius : ndarray, shape (N,)
+        In kg and m.
+    reach : float
+        A step is left to the drift when the largest velocity component (m/s) times ``dt``
+        is not within this distance (m; `collidium.collisions` refuses it then).
+    audit_shape, limit_x, limit_y, slack, periodic
+        The vessel as `collidium.kernels.audit.first_invalid` takes it (``segments`` too).
+    window_is_vessel : bool
+        Whether the cells' window covers the vessel (disks outside it are then no reason to
+        build the queue again).
+    record : ndarray, shape (count, len(RECORD))
+        Output: `collidium.kernels.substeps.RECORD` at each step's end (no potential energy
+        or pair virial without forces: 0).
+    counts, impulses, heats : ndarray, shape (count, 1 + W)
+        Output: ``tally``, ``impulse`` and ``heat`` at each step's end.
+
+    Returns
+    -------
+    tuple of int
+        ``(steps taken, events processed, how it ended)``: `ALL`, `STOPPED`, `OUT_OF_WINDOW`,
+        or ``-1 - i`` if time stopped advancing at particle i in the step after those taken
+        (`events.run_events`; the tallies then hold part of that step).
+    """
+    processed = 0
+    for k in range(count):
+        now = origin + (elapsed + k) * dt
+        if not _largest_component(velocity) * dt <= reach:  # also NaN
+            return k, processed, STOPPED
+        until = now + dt
+        done = events.run_events(until, body, image, geometry, grid, head, next_, event, keys,
+                                 items, tally, impulse, acceleration, now + 0.5 * dt,
+                                 sort_every, halt, walls, heat, segments, piston)  # fmt: skip
+        if done < 0:
+            return k, processed, done
+        processed += done
+        strays = events.synchronise(until, body, event, geometry, grid, position, velocity)
+        _record(k, mass, velocity, tally, impulse, heat, record, counts, impulses, heats)
+        invalid, _ = in_order(position, velocity, radius, audit_shape, limit_x, limit_y, slack,
+                              periodic, segments)  # fmt: skip
+        if invalid >= 0:
+            return k + 1, processed, STOPPED
+        if strays > 0 and not window_is_vessel:
+            return k + 1, processed, OUT_OF_WINDOW
+    return count, processed, ALL
+
+
+@numba.njit(cache=True)
+def _largest_component(velocity) -> float:
+    """``max |v_i,d|`` over the particles and axes (m/s), as ``collidium.collisions`` takes it
+    from NumPy's maximum and minimum: NaN if any is NaN."""
+    largest = 0.0
+    for i in range(velocity.shape[0]):
+        for d in range(2):
+            size = abs(velocity[i, d])
+            if size != size:  # NaN
+                return size
+            largest = max(largest, size)
+    return largest
+
+
+@numba.njit(cache=True)
+def _record(k, mass, velocity, tally, impulse, heat, record, counts, impulses, heats) -> None:
+    """Row k of the records: `collidium.kernels.substeps.RECORD` and the tallies."""
+    px, py = momentum(mass, velocity)
+    record[k, 0] = kinetic_energy(mass, velocity)
+    record[k, 1] = 0.0
+    record[k, 2] = 0.0
+    record[k, 3] = px
+    record[k, 4] = py
+    record[k, 5] = total_speed(velocity)
+    for w in range(tally.shape[0]):
+        counts[k, w] = tally[w]
+        impulses[k, w] = impulse[w]
+        heats[k, w] = heat[w]

@@ -1,0 +1,106 @@
+"""The exact engine's compiled steps without forces (`event_flights`) against the twin, and where
+they stop."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from collidium import Box, Circle, Particles, Simulation, collisions
+from collidium.collisions import ExactCollisions, FlightRecord
+from collidium.kernels import event_flights, reference
+from lattices import jittered_lattice
+
+STEPS = 7
+
+
+def _gas(rng: np.random.Generator, vessel: Box | Circle, side: float) -> Simulation:
+    """A gas of unequal disks, its queue built by a first step."""
+    position = jittered_lattice(10, side, 0.4, rng)
+    n = len(position)
+    velocity = rng.uniform(-10, 10, (n, 2))
+    mass, radius = rng.uniform(0.5, 2.0, n), rng.uniform(0.1, 0.4, n)
+    particles = Particles(position, velocity, mass=mass, radius=radius)
+    return Simulation(vessel, particles, dt=0.1).run(steps=1)
+
+
+def _fly(sim: Simulation, steps: int = STEPS) -> tuple[int, FlightRecord]:
+    drift = sim._drift
+    assert isinstance(drift, ExactCollisions)
+    record = FlightRecord.empty(steps, sim.tally)
+    origin, start = sim._time_origin
+    flown = drift.fly(sim.particles, sim.container, origin, sim.steps - start, sim.dt, sim.tally,
+                      record)  # fmt: skip
+    return flown, record
+
+
+@pytest.mark.parametrize("shape", ["box", "circle"])
+def test_flown_steps_match_the_twin(rng, shape):
+    """Steps flown in one call end as the all-pairs twin's steps do, and record at each end the
+    same energies, momentum, total speed, counts and impulses, to the round-off growth of a
+    chaotic gas (`tests/kernels/test_events.py`)."""
+    vessel = Box(20.0, 20.0) if shape == "box" else Circle(10.0)
+    sim = _gas(rng, vessel, 20.0 if shape == "box" else 13.0)
+    p = sim.particles
+    position, velocity = p.position.copy(), p.velocity.copy()
+    tally = sim.tally.counts.copy(), sim.tally.impulse.copy()
+    flown, record = _fly(sim)
+    half = np.array([10.0, 10.0])
+    values, counts, impulses = reference.event_intervals(
+        position, velocity, p.mass, p.radius, half, sim.dt, STEPS,
+        rim=10.0 if shape == "circle" else None,
+    )  # fmt: skip
+    assert flown == STEPS
+    assert counts[-1, 0] > 5 and counts[-1, 1] > 5
+    pairs, walls = record.counts[:, 0], record.counts[:, 1:].sum(axis=1)
+    np.testing.assert_array_equal(pairs, tally[0][0] + counts[:, 0])
+    np.testing.assert_array_equal(walls, tally[0][1:].sum() + counts[:, 1])
+    np.testing.assert_allclose(record.impulse, tally[1] + impulses, rtol=1e-9)
+    np.testing.assert_allclose(record.values, values, rtol=1e-9, atol=1e-9 * values[0, 0])
+    np.testing.assert_allclose(p.position, position, rtol=0, atol=1e-9 * 10.0)
+    np.testing.assert_allclose(p.velocity, velocity, rtol=0, atol=1e-8 * 10)
+    np.testing.assert_array_equal(record.heat, 0.0)
+
+
+def test_a_refused_speed_stops_before_the_step(rng, monkeypatch):
+    """A step whose speeds the drift would refuse is left to the drift, untouched."""
+    sim = _gas(rng, Box(20.0, 20.0), 20.0)
+    position, counts = sim.particles.position.copy(), sim.tally.counts.copy()
+    monkeypatch.setattr(collisions, "_runaway_reach", lambda vessel: 1e-3)
+    flown, _ = _fly(sim)
+    assert flown == 0
+    np.testing.assert_array_equal(sim.particles.position, position)
+    np.testing.assert_array_equal(sim.tally.counts, counts)
+
+
+def test_time_that_stops_advancing_puts_the_tallies_back(rng, monkeypatch):
+    """A step at which time stops advancing (a runaway state) is left to the drift, which says
+    where it stopped: the flight puts back what the step added to the tallies and drops the
+    queue, so that the drift builds it again from the particles the last step wrote."""
+    sim = _gas(rng, Box(20.0, 20.0), 20.0)
+    kernel = event_flights.event_intervals
+
+    def stuck_in_the_third(*args):
+        flown, processed, _ = kernel(*args[:3], 2, *args[4:])
+        tally = args[13]
+        tally += 5  # part of the third step, counted
+        return flown, processed, -1 - 4
+
+    monkeypatch.setattr(event_flights, "event_intervals", stuck_in_the_third)
+    flown, record = _fly(sim)
+    assert flown == 2
+    np.testing.assert_array_equal(sim.tally.counts, record.counts[1])
+    assert sim._drift._state is None
+
+
+def test_a_failed_audit_ends_the_flight_after_its_step(rng, monkeypatch):
+    """A step that leaves a disk outside the vessel (here a vessel made smaller for the audit
+    alone) is taken and ends the flight, for the run loop's audit to report."""
+    sim = _gas(rng, Box(20.0, 20.0), 20.0)
+    code, _, _, slack, periodic = sim.container.audit_arguments()
+    # The disks reach further out at some step of the next seven than they do now.
+    now = float(np.max(np.abs(sim.particles.position) + sim.particles.radius[:, None]))
+    monkeypatch.setattr(Box, "audit_arguments", lambda self: (code, now, now, slack, periodic))
+    flown, _ = _fly(sim)
+    assert 1 <= flown < STEPS
+    assert np.max(np.abs(sim.particles.position) + sim.particles.radius[:, None]) > now
