@@ -20,8 +20,10 @@ import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
+from collidium.kernels.compilation import inlined
 
-@numba.njit(cache=True, inline="always")
+
+@inlined
 def cell_index(x: float, low: float, cell: float, count: int) -> int:
     """Index along one axis of the cell holding coordinate ``x`` (clamped to the grid), for a
     grid starting at ``low`` with cells ``cell`` wide (m)."""
@@ -78,7 +80,7 @@ def fill_cells(
         head[c] = i
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def neighbour_cell(cx, cy, ox, oy, ncx, ncy, periodic, width, height):
     """The cell at offset ``(ox, oy)`` from cell ``(cx, cy)``, and the shift to add to the
     positions of its particles to reach the image next to ``(cx, cy)``.

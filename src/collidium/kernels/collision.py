@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import math
 
-import numba
+from collidium.kernels.compilation import inlined
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def pair_response(
     m1: float,
     m2: float,
@@ -56,7 +56,7 @@ def pair_response(
     return v1x - f1 * nx, v1y - f1 * ny, v2x + f2 * nx, v2y + f2 * ny
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def energy_change(m1, m2, u1x, u1y, u2x, u2y, v1x, v1y, v2x, v2y) -> float:
     """Kinetic energy (J) two disks of masses m1, m2 (kg) gain when their velocities go from
     u1, u2 to v1, v2 (m/s): what an inelastic collision takes, negative."""

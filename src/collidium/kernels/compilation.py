@@ -10,8 +10,25 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from typing import Any
 
+import numba
 from numba.core import event as numba_event
+
+
+def uncounted(**options: Any) -> Any:
+    """numba.njit, cached, for kernels that allocate nothing: compiled without numba's
+    reference counting, which cannot prune the atomic counts it emits around array arguments
+    when they span branches (numba issue #2350; with them the exact engine's prediction cost
+    five times as much, 150 against 30 ns at 1,000 disks)."""
+    return numba.njit(**{"cache": True, "_nrt": False, **options})
+
+
+#: For the helpers of such kernels: LLVM inlines them into their callers (numba's
+#: ``forceinline``), and numba types each once; ``inline="always"`` inlines at numba's level
+#: and types every copy again, most of a minute of the exact engine's first compilation
+#: (ARCHITECTURE.md, "Compile time").
+inlined = uncounted(forceinline=True)
 
 
 class _FirstCompile(numba_event.Listener):

@@ -46,12 +46,12 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from collidium.kernels import parabolas, wall_responses
 from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import energy_change, pair_response
+from collidium.kernels.compilation import inlined, uncounted
 from collidium.kernels.vessels import BOX, contacts
 from collidium.kernels.vessels import piston as pistons
 
@@ -110,17 +110,7 @@ WALL_HITS = 1  # one entry per wall, `Vessel.wall_names` order (tally: hits; imp
 CONTACT_SLACK = 1e-12
 
 
-def _engine(**options):
-    """numba.njit for the engine's kernels, compiled without numba's reference counting.
-
-    The engine never allocates, and numba cannot prune the atomic reference counts it emits
-    around the array arguments of inlined helpers when they span branches (numba issue #2350):
-    with them a prediction cost five times as much (150 against 30 ns, 1,000 disks).
-    """
-    return numba.njit(cache=True, _nrt=False, **options)
-
-
-@_engine(inline="always")
+@inlined
 def _slot_views(event):
     """The slots' particles, cells, event counts and heap places: columns of ``event``, (N,).
 
@@ -136,19 +126,19 @@ def _slot_views(event):
 SORT_INTERVAL = 16
 
 
-@_engine(inline="always")
+@inlined
 def _radius(k, body, geometry) -> float:
     """Radius of slot k in m: its row's, or the one all disks share."""
     return body[k, RADIUS] if body.shape[1] > RADIUS else geometry[SHARED_RADIUS]
 
 
-@_engine(inline="always")
+@inlined
 def _mass(k, body, geometry) -> float:
     """Mass of slot k in kg: its row's, or the one all disks share."""
     return body[k, MASS] if body.shape[1] > MASS else geometry[SHARED_MASS]
 
 
-@_engine(inline="always")
+@inlined
 def _at(k, t, body, geometry):
     """Slot k's position (m) and velocity (m/s) at time t (s): ``(x, y, vx, vy)``."""
     lag = t - body[k, STAMP]
@@ -161,7 +151,7 @@ def _at(k, t, body, geometry):
     return x, y, vx + gx * lag, vy + gy * lag
 
 
-@_engine(inline="always")
+@inlined
 def contact_delay(
     dx: float, dy: float, dvx: float, dvy: float, sigma: float, slack: float = 0.0
 ) -> float:
@@ -208,7 +198,7 @@ def contact_delay(
 # (`earliest`), so the order of events is still the total order (time, ident).
 
 
-@_engine(inline="always")
+@inlined
 def _sift_up(slot, key, item, keys, items, where) -> int:
     """Move ``(key, item)`` up from ``slot`` to its place; return where it landed."""
     while slot > 0:
@@ -227,7 +217,7 @@ def _sift_up(slot, key, item, keys, items, where) -> int:
     return slot
 
 
-@_engine(inline="always")
+@inlined
 def _sift_down(slot, key, item, keys, items, where) -> None:
     """Move ``(key, item)`` down from ``slot`` to its place."""
     n = keys.shape[0]
@@ -253,7 +243,7 @@ def _sift_down(slot, key, item, keys, items, where) -> None:
     where[item] = slot
 
 
-@_engine(inline="always")
+@inlined
 def heap_update(k, key, keys, items, where) -> None:
     """Give slot k the event time ``key`` (s) and restore heap order (O(log N))."""
     slot = where[k]
@@ -261,7 +251,7 @@ def heap_update(k, key, keys, items, where) -> None:
         _sift_down(slot, key, k, keys, items, where)
 
 
-@_engine()
+@uncounted()
 def _earliest_tied(keys, items, ident) -> int:
     """Among the entries whose time equals the root's, the slot with the lowest ident.
 
@@ -288,7 +278,7 @@ def _earliest_tied(keys, items, ident) -> int:
     return best
 
 
-@_engine(inline="always")
+@inlined
 def earliest(keys, items, ident) -> int:
     """The slot whose event comes first in the order (time, ident)."""
     for c in range(1, min(ARITY + 1, keys.shape[0])):
@@ -297,7 +287,7 @@ def earliest(keys, items, ident) -> int:
     return items[0]
 
 
-@_engine()
+@uncounted()
 def _heap_build(keys, items, where) -> None:
     """Order a heap whose ``keys[s]`` belong to slot ``s`` (O(N))."""
     n = keys.shape[0]
@@ -311,7 +301,7 @@ def _heap_build(keys, items, where) -> None:
 # --- predictions --------------------------------------------------------------------------------
 
 
-@_engine(inline="always")
+@inlined
 def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid, segments, piston, now):
     """Earliest wall contact or cell crossing of a disk at (x, y) moving at (vx, vy) in cell c at
     time ``now`` (s), falling with the acceleration in ``geometry``: ``(delay in s, code)``. Ties
@@ -338,7 +328,7 @@ def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid, segments, piston, now):
     return best, code
 
 
-@_engine(inline="always")
+@inlined
 def _cell_crossing(x, y, vx, vy, c, geometry, grid):
     """``(delay in s, code)`` of a straight path's crossing out of cell c (code ``-1 - (2 d +
     upper)``; none out of the edge cells of a walled box). Ties go to x."""
@@ -364,12 +354,12 @@ def _cell_crossing(x, y, vx, vy, c, geometry, grid):
     return best, code
 
 
-@_engine()
+@uncounted()
 def _falling_cell_crossing(x, y, vx, vy, gx, gy, c, geometry, grid):
     """`_cell_crossing` on a parabola: each edge's gap closes on a quadratic (a disk thrown up
     may cross its cell's lower edge on the way down). Ties go to x, then to the lower edge. A
-    call, not inlined: only falling disks take it, and inlined it would add to the compile
-    time of every engine."""
+    call, not inlined: only falling disks take it, and inlined it would add to LLVM's work on
+    every engine."""
     ncx = grid[0]
     periodic = grid[2] != 0
     best = math.inf
@@ -392,7 +382,7 @@ def _falling_cell_crossing(x, y, vx, vy, gx, gy, c, geometry, grid):
     return best, code
 
 
-@_engine(inline="always")
+@inlined
 def _delay_to(j, now, x, y, vx, vy, r, sx, sy, body, geometry) -> float:
     """Time (s) from ``now`` until slot j, shifted by (sx, sy) m, touches a disk of radius r at
     (x, y) moving at (vx, vy); inf if never or if j has radius 0."""
@@ -408,7 +398,7 @@ def _delay_to(j, now, x, y, vx, vy, r, sx, sy, body, geometry) -> float:
     return contact_delay(dx, dy, vjx - vx, vjy - vy, sigma, slack)
 
 
-@_engine(inline="always")
+@inlined
 def _delay_to_any_image(j, now, x, y, vx, vy, r, body, geometry, grid) -> float:
     """`_delay_to` slot j, or in a periodic box to the image of j that comes first."""
     if grid[2] == 0:
@@ -420,7 +410,7 @@ def _delay_to_any_image(j, now, x, y, vx, vy, r, body, geometry, grid) -> float:
     return best
 
 
-@_engine(inline="always")
+@inlined
 def _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry, grid, cell_of,
                 head, next_):  # fmt: skip
     """Earliest contact of slot k, at (x, y) at time ``now``, with the disks in a block of cells
@@ -454,7 +444,7 @@ def _scan_cells(k, now, x, y, vx, vy, r, rows, columns, body, ident, geometry, g
     return best, best_slot
 
 
-@_engine(inline="always")
+@inlined
 def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, count, event,
             segments, piston):  # fmt: skip
     """Find slot k's next event after time ``now`` (s), store it, return its time (s).
@@ -510,13 +500,13 @@ def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, 
     return when
 
 
-@_engine()
+@uncounted()
 def _predict_not_inlined(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_,
                          count, event, segments, piston):  # fmt: skip
     """`predict` as a call rather than an inlined copy, for the passes over every slot (`rebuild`,
-    `_piston_moved`): numba's inlining and typing of each copy cost seconds of every first
-    compilation, and save nothing there, where the prediction dwarfs the call. The event loop
-    keeps its inlined copies: a call there costs 7 to 10% of the collisions per second."""
+    `_piston_moved`): each copy adds to LLVM's work at the first compilation, and saves nothing
+    there, where the prediction dwarfs the call. The event loop keeps its inlined copies: a
+    call there costs 7 to 10% of the collisions per second."""
     return predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, count,
                    event, segments, piston)  # fmt: skip
 
@@ -524,14 +514,14 @@ def _predict_not_inlined(k, now, crossed, body, ident, geometry, grid, cell_of, 
 # --- cells and slots ----------------------------------------------------------------------------
 
 
-@_engine(inline="always")
+@inlined
 def _push_front(k, c, head, next_) -> None:
     """Put slot k first in cell c's list."""
     next_[k] = head[c]
     head[c] = k
 
 
-@_engine()
+@uncounted()
 def _link_cells(cell_of, head, next_) -> None:
     """Rebuild the per-cell linked lists from ``cell_of``, each in increasing slot order."""
     head[:] = -1
@@ -539,7 +529,7 @@ def _link_cells(cell_of, head, next_) -> None:
         _push_front(k, cell_of[k], head, next_)
 
 
-@_engine(inline="always")
+@inlined
 def _move_to_cell(k, new, cell_of, head, next_) -> None:
     """Take slot k out of its cell's list and put it first in cell ``new``'s. A cell holds a
     few disks: walking its list is as fast as keeping back links, and takes no memory."""
@@ -554,7 +544,7 @@ def _move_to_cell(k, new, cell_of, head, next_) -> None:
     cell_of[k] = new
 
 
-@_engine(inline="always")
+@inlined
 def _cross_cell(k, direction, body, ident, image, geometry, grid, cell_of, head, next_):
     """Move slot k into the neighbouring cell; wrap it at a periodic edge."""
     ncx = grid[0]
@@ -572,14 +562,14 @@ def _cross_cell(k, direction, body, ident, image, geometry, grid, cell_of, head,
     _move_to_cell(k, cx + ncx * cy, cell_of, head, next_)
 
 
-@_engine(inline="always")
+@inlined
 def _swap_rows(array, a, b) -> None:
     """Exchange rows a and b of a 2-d array."""
     for column in range(array.shape[1]):
         array[a, column], array[b, column] = array[b, column], array[a, column]
 
 
-@_engine()
+@uncounted()
 def sort_slots(body, cell_of, event, head, next_, items, where) -> None:
     """Renumber the slots in cell order (a counting sort), keeping every reference consistent.
 
@@ -621,7 +611,7 @@ def sort_slots(body, cell_of, event, head, next_, items, where) -> None:
     _link_cells(cell_of, head, next_)
 
 
-@_engine()
+@uncounted()
 def rebuild(now, body, geometry, grid, head, next_, event, keys, items, segments, piston) -> None:
     """Start a fresh queue at time ``now`` (s) from positions synchronised at ``now``.
 
@@ -652,7 +642,7 @@ def rebuild(now, body, geometry, grid, head, next_, event, keys, items, segments
 # --- the drift ----------------------------------------------------------------------------------
 
 
-@_engine()
+@uncounted()
 def run_events(
     until: float,
     body: np.ndarray,
@@ -793,7 +783,7 @@ def run_events(
     return processed
 
 
-@_engine()
+@uncounted()
 def _push_piston(k, t, body, ident, geometry, tally, impulse, heat, piston):
     """Slot k hits the piston at time t (s): snapped onto its face, both respond
     (`collidium.kernels.vessels.piston.hit`); the hit, the momentum and the work done on the gas
@@ -814,7 +804,7 @@ def _push_piston(k, t, body, ident, geometry, tally, impulse, heat, piston):
     heat[wall] += work
 
 
-@_engine()
+@uncounted()
 def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count, event, keys,
                   items, where, segments, piston) -> None:  # fmt: skip
     """The piston's path changed at time ``now`` (s): every disk whose next event was a contact
@@ -835,7 +825,7 @@ def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count,
             heap_update(k, when, keys, items, where)
 
 
-@_engine(inline="always")
+@inlined
 def _halts(k, t, body, ident, count, event, acceleration, halt) -> bool:
     """Whether slot k's event at time t is a contact that halts the drift (see `run_events`):
     a wall hit of a particle with an acceleration, or a valid pair collision of two particles
@@ -867,14 +857,14 @@ def _halts(k, t, body, ident, count, event, acceleration, halt) -> bool:
     return True
 
 
-@_engine(inline="always")
+@inlined
 def _advance(k: int, t: float, body: np.ndarray, geometry: np.ndarray) -> None:
     """Bring slot k's row to time t (s)."""
     body[k, X], body[k, Y], body[k, VX], body[k, VY] = _at(k, t, body, geometry)
     body[k, STAMP] = t
 
 
-@_engine(inline="always")
+@inlined
 def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration, midpoint, heat):
     """Collision of slots k and j at time t (s); an inelastic one books the kinetic energy it
     takes in ``heat[PAIR_COLLISIONS]`` (J, negative)."""
@@ -902,7 +892,7 @@ def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
     tally[PAIR_COLLISIONS] += 1
 
 
-@_engine(inline="always")
+@inlined
 def _bounce(k, contact, t, body, ident, geometry, tally, impulse, acceleration, midpoint, walls,
             heat, segments):  # fmt: skip
     """Slot k meets the vessel at ``contact`` (`collidium.kernels.vessels.contacts`) at time t
@@ -945,7 +935,7 @@ def _bounce(k, contact, t, body, ident, geometry, tally, impulse, acceleration, 
     tally[WALL_HITS + wall] += 1
 
 
-@_engine(inline="always")
+@inlined
 def _pair_response(k, j, nx, ny, lead, body, ident, geometry, acceleration):
     """Velocities of k and j after their collision, with the kick timing corrected.
 
@@ -975,7 +965,7 @@ def _pair_response(k, j, nx, ny, lead, body, ident, geometry, acceleration):
     return pair_response(m1, m2, nx, ny, v1x, v1y, v2x, v2y, e, below)
 
 
-@_engine(inline="always")
+@inlined
 def _wall_response(outward, pull, lead, forced):
     """Velocity along a wall's outward normal after a bounce, from ``outward`` before it (m/s),
     with the kick-timing correction of pairs when ``forced``: ``pull`` is the acceleration along
@@ -991,7 +981,7 @@ def _wall_response(outward, pull, lead, forced):
 # --- between the engine and the particles -------------------------------------------------------
 
 
-@_engine()
+@uncounted()
 def load(position, velocity, radius, mass, body, event) -> None:
     """Fill ``body`` (N, 7), or (N, 5) without radius and mass, and the slots' particles
     (``event[:, IDENT]``) from the particles, in particle order.
@@ -1014,7 +1004,7 @@ def load(position, velocity, radius, mass, body, event) -> None:
         event[i, IDENT] = i
 
 
-@_engine()
+@uncounted()
 def synchronise(now, body, event, geometry, grid, position, velocity) -> int:
     """Write every particle's position at time ``now`` (s) and velocity into ``position`` and
     ``velocity`` (N, 2), by particle; the lazily kept state is untouched so the queue stays
@@ -1035,7 +1025,7 @@ def synchronise(now, body, event, geometry, grid, position, velocity) -> int:
     return strays
 
 
-@_engine()
+@uncounted()
 def matches(now, body, event, geometry, position, velocity, radius, mass) -> bool:
     """True if the particles are exactly what `synchronise` wrote at ``now`` (s), with the
     engine's radii and masses: nobody changed them since, and the queue is still valid."""

@@ -17,12 +17,14 @@ import math
 
 import numba
 
+from collidium.kernels.compilation import inlined
+
 #: Newton-bisection iterations at most for one root (bisection alone halves the bracket each
 #: time: 64 from any bracket of floats down to round-off, with margin).
 ITERATIONS = 200
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def first_contact(gap: float, rate: float, pull: float) -> float:
     """The first time t >= 0 at which ``gap + rate t + pull t^2 / 2`` reaches 0 from above, s.
 
@@ -54,7 +56,7 @@ def first_contact(gap: float, rate: float, pull: float) -> float:
     return (rate + math.sqrt(rate * rate - 2.0 * pull * gap)) / -pull
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def first_root(a: float, b: float, c: float, rising: bool) -> float:
     """The root of ``a t^2 + b t + c`` at which it is rising (slope > 0) or falling, s; NaN if
     there is none. Stable forms: no cancellation whatever the signs."""
@@ -72,7 +74,7 @@ def first_root(a: float, b: float, c: float, rising: bool) -> float:
     return (-b - root) / (2.0 * a) if b >= 0.0 else 2.0 * c / (-b + root)
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def _state(px, py, vx, vy, gx, gy, t):
     """Position and velocity after t seconds on the parabola."""
     return (px + (vx + 0.5 * gx * t) * t, py + (vy + 0.5 * gy * t) * t, vx + gx * t, vy + gy * t)

@@ -21,8 +21,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+
+from collidium.kernels.compilation import inlined
 
 #: Response codes of the wall table.
 SPECULAR, INELASTIC, THERMAL, PISTON = 0, 1, 2, 3
@@ -34,7 +35,7 @@ WALL_TABLE_COLUMNS = 3
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def _mix(z: np.uint64) -> np.uint64:
     """SplitMix64's finaliser: a bijection of 64-bit words that scrambles every bit."""
     z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
@@ -42,7 +43,7 @@ def _mix(z: np.uint64) -> np.uint64:
     return z ^ (z >> np.uint64(31))
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def uniform(key: float, particle: int, hit: int, draw: int) -> float:
     """A uniform number in (0, 1], a function of its four arguments alone (``key`` a whole
     number below 2^53)."""
@@ -52,7 +53,7 @@ def uniform(key: float, particle: int, hit: int, draw: int) -> float:
     return (float(z >> np.uint64(11)) + 1.0) * 2.0**-53
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def respond(
     table: np.ndarray,
     wall: int,
@@ -95,7 +96,7 @@ def respond(
     return -outward, along
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def bounce(
     table: np.ndarray,
     wall: int,
@@ -119,7 +120,7 @@ def bounce(
     return wx, wy, mass * abs(after - outward), heat
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def hit(table, wall, vx, vy, nx, ny, mass, particle, hits, impulse, heat, slot):
     """`bounce`, booked: counts the hit and adds the wall's impulse and heat at ``slot`` of
     ``hits``, ``impulse`` and ``heat`` (the wall's entry of the caller's tallies). Returns the
@@ -131,7 +132,7 @@ def hit(table, wall, vx, vy, nx, ny, mass, particle, hits, impulse, heat, slot):
     return wx, wy
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def moving_wall(
     outward: float, wall: float, mass: float, wall_mass: float, restitution: float
 ) -> tuple[float, float]:

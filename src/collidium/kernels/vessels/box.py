@@ -15,9 +15,10 @@ import numba
 import numpy as np
 
 from collidium.kernels import parabolas
+from collidium.kernels.compilation import inlined
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def wall_delay(
     x: float,
     y: float,
@@ -77,7 +78,7 @@ def _falling_wall_delay(x, y, vx, vy, r, half_width, half_height, gx, gy) -> tup
     return best, wall
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def contact_coordinate(wall: int, r: float, half_width: float, half_height: float) -> float:
     """Where the centre of a disk of radius ``r`` touching ``wall`` is along the wall's axis
     (``wall // 2``), in m: the snap that keeps round-off from leaving a disk past the wall."""
@@ -85,14 +86,14 @@ def contact_coordinate(wall: int, r: float, half_width: float, half_height: floa
     return (half - r) if wall % 2 == 1 else (r - half)
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def reaches_outside(x: float, y: float, reach: float, limit_x: float, limit_y: float) -> bool:
     """Whether a disk at (x, y) reaching ``reach`` m from its centre (its radius; 0 for the
     centre alone) passes the half sides ``limit_x, limit_y`` (m, round-off allowance included)."""
     return abs(x) + reach > limit_x or abs(y) + reach > limit_y
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def fold(x: float, v: float, lo: float, hi: float) -> tuple[float, float, int]:
     """Reflect a free-flight coordinate back into ``[lo, hi]``.
 

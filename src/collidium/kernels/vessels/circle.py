@@ -11,12 +11,11 @@ from __future__ import annotations
 
 import math
 
-import numba
-
 from collidium.kernels import parabolas
+from collidium.kernels.compilation import inlined
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def wall_delay(
     x: float,
     y: float,
@@ -54,7 +53,7 @@ def wall_delay(
     return max(delay, 0.0), 0
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def outward_normal(x: float, y: float) -> tuple[float, float]:
     """Unit outward normal of the rim at the direction of (x, y) (x axis at the centre)."""
     length = math.hypot(x, y)
@@ -63,7 +62,7 @@ def outward_normal(x: float, y: float) -> tuple[float, float]:
     return x / length, y / length
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def contact_point(x: float, y: float, r: float, rim: float) -> tuple[float, float]:
     """(x, y) moved along its direction to ``rim - r`` from the centre: where a disk of radius
     ``r`` touching the rim there is (the snap that keeps round-off from leaving it outside)."""
@@ -72,7 +71,7 @@ def contact_point(x: float, y: float, r: float, rim: float) -> tuple[float, floa
     return nx * reach, ny * reach
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def reaches_outside(x: float, y: float, reach: float, limit: float) -> bool:
     """Whether a disk at (x, y) reaching ``reach`` m from its centre passes ``limit`` m from the
     origin (the rim with its round-off allowance)."""

@@ -14,13 +14,14 @@ import numba
 import numpy as np
 
 from collidium.kernels import wall_responses
+from collidium.kernels.compilation import inlined
 from collidium.kernels.vessels import BOX, CIRCLE, box, circle, segments
 
 #: The first contact that is a segment: shapes have at most this many walls of their own.
 SEGMENTS_FROM = 4
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def earliest(
     x, y, vx, vy, r, shape, half_width, half_height, rim, table, gx=0.0, gy=0.0, horizon=math.inf
 ) -> tuple[float, int]:
@@ -41,7 +42,7 @@ def earliest(
     return best, contact
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def touch(contact, x, y, vx, vy, r, shape, half_width, half_height, rim, table):
     """A disk of radius ``r`` at (x, y) moving at (vx, vy) touching ``contact``:
     ``(x, y, nx, ny, wall)``, its centre snapped onto the contact line (so that round-off never
@@ -62,7 +63,7 @@ def touch(contact, x, y, vx, vy, r, shape, half_width, half_height, rim, table):
     return x, touching, 0.0, sign, contact
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def reaches_outside(x, y, reach, shape, limit_x, limit_y, slack, table) -> bool:
     """Whether a disk at (x, y) reaching ``reach`` m from its centre passes the shape's limits
     (`collidium.vessels.Vessel.audit_arguments`, round-off allowance included) or comes closer than

@@ -21,6 +21,7 @@ import numba
 import numpy as np
 
 from collidium.kernels import wall_responses
+from collidium.kernels.compilation import inlined
 from collidium.kernels.parabolas import first_contact
 from collidium.kernels.vessels import box
 
@@ -32,7 +33,7 @@ WALL, HEIGHT, SPEED, PULL, STAMP, MASS, RESTITUTION, LOW, HIGH, NEXT, DRIVEN = r
 PISTON_SIZE = 11
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def motion(piston: np.ndarray, t: float) -> tuple[float, float]:
     """The piston's height (m) and speed (m/s) along its outward normal at time t (s)."""
     lag = t - piston[STAMP]
@@ -40,7 +41,7 @@ def motion(piston: np.ndarray, t: float) -> tuple[float, float]:
     return piston[HEIGHT] + (speed + 0.5 * piston[PULL] * lag) * lag, speed + piston[PULL] * lag
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def move_to(piston: np.ndarray, t: float) -> None:
     """Bring the piston's stamped state to time t (s)."""
     height, speed = motion(piston, t)
@@ -49,13 +50,13 @@ def move_to(piston: np.ndarray, t: float) -> None:
     piston[STAMP] = t
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def _axis_and_sign(piston: np.ndarray) -> tuple[int, float]:
     wall = int(piston[WALL])
     return wall // 2, (1.0 if wall % 2 == 1 else -1.0)
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def delay(piston, now, x, y, vx, vy, r, gx=0.0, gy=0.0) -> float:
     """Time (s) from ``now`` until a disk of radius r at (x, y) moving at (vx, vy) under the
     acceleration (gx, gy) (m/s^2) touches the piston; inf if never on their present paths."""

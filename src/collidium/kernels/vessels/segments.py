@@ -19,13 +19,14 @@ import math
 import numba
 
 from collidium.kernels import parabolas
+from collidium.kernels.compilation import inlined
 
 #: Columns of a segment table.
 X0, Y0, X1, Y1, TX, TY, LENGTH, WALL, BOUNDARY = range(9)
 SEGMENT_COLUMNS = 9
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def point_delay(px: float, py: float, vx: float, vy: float, r: float) -> float:
     """Time until a disk of radius ``r`` whose centre is (px, py) from a point, moving at
     (vx, vy), touches the point; inf if it never does. A disk already within ``r`` that moves
@@ -42,7 +43,7 @@ def point_delay(px: float, py: float, vx: float, vy: float, r: float) -> float:
     return c / (math.sqrt(disc) - b)  # the earlier root, without cancellation
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def element_delay(
     x: float,
     y: float,
@@ -111,7 +112,7 @@ def _flat_delay_on_parabola(px, py, vx, vy, gx, gy, r, tx, ty, length) -> float:
     return best
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def earliest(
     x: float,
     y: float,
@@ -134,7 +135,7 @@ def earliest(
     return best, found
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def nearest_point(x: float, y: float, segments, e: int) -> tuple[float, float]:
     """The point of segment ``e`` nearest to (x, y), m."""
     along = (x - segments[e, X0]) * segments[e, TX] + (y - segments[e, Y0]) * segments[e, TY]
@@ -142,14 +143,14 @@ def nearest_point(x: float, y: float, segments, e: int) -> tuple[float, float]:
     return segments[e, X0] + along * segments[e, TX], segments[e, Y0] + along * segments[e, TY]
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def distance(x: float, y: float, segments, e: int) -> float:
     """Distance in m from (x, y) to segment ``e``."""
     qx, qy = nearest_point(x, y, segments, e)
     return math.hypot(qx - x, qy - y)
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def touch(
     x: float, y: float, vx: float, vy: float, r: float, segments, e: int
 ) -> tuple[float, float, float, float]:
@@ -180,7 +181,7 @@ def touch(
     return qx - r * nx, qy - r * ny, nx, ny
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def inside_boundary(x: float, y: float, segments) -> bool:
     """Whether (x, y) is inside the polygon the boundary rows make (crossing number); True when
     there are none (the vessel's shape is not a polygon)."""
@@ -198,7 +199,7 @@ def inside_boundary(x: float, y: float, segments) -> bool:
     return edges == 0 or crossings % 2 == 1
 
 
-@numba.njit(cache=True, inline="always")
+@inlined
 def reaches_outside(x: float, y: float, reach: float, slack: float, segments) -> bool:
     """Whether a disk at (x, y) reaching ``reach`` m from its centre comes closer than
     ``reach - slack`` (m, the round-off allowance) to any segment, or has its centre outside the
