@@ -450,6 +450,62 @@ def test_exact_steps_flown_without_forces_are_bitwise_those_taken_one_by_one(
         np.testing.assert_array_equal(getattr(ours[2], column), getattr(theirs[2], column))
 
 
+class StepRecorder:
+    """An observer of the state that notes the steps it fires on."""
+
+    def __init__(self, trigger) -> None:
+        self.trigger = trigger
+        self.steps: list[int] = []
+
+    def attach(self, sim: cd.Simulation) -> None:
+        pass
+
+    def update(self, sim: cd.Simulation) -> None:
+        self.steps.append(sim.steps)
+
+
+@pytest.mark.parametrize(("name", "time"), [("gas", 1.5), ("orbit", 1.5)])
+def test_runs_fly_up_to_the_firings_of_interval_and_after_triggers(monkeypatch, name, time):
+    """Observers of the state on `Interval` and `After` triggers fire on the same steps of a
+    flown run as of one stepped one by one, the steps between them flown; an energy series on
+    an `Interval` gets the same samples, and measurements that start under an `After` trigger
+    (from the energy and walls of their first sample) measure the same; a trigger of the
+    user's own flies nothing."""
+    flown_steps = []
+    fly = cd.Simulation._fly
+
+    def counted(self, run):
+        flown = fly(self, run)
+        flown_steps.append(flown)
+        return flown
+
+    monkeypatch.setattr(cd.Simulation, "_fly", counted)
+    runs = []
+    for extra in ([], [StateReader(Every(1))]):
+        sim = cd.load(name)
+        recorders = [StepRecorder(cd.observers.Interval(0.037)),
+                     StepRecorder(cd.observers.After(0.5, Every(7)))]  # fmt: skip
+        series = cd.observers.EnergySeries(cd.observers.Interval(0.05))
+        later = [cd.observers.EnergyDrift(cd.observers.After(0.5, Every(3))),
+                 cd.observers.Thermo(cd.observers.After(0.3, Every(5)))]  # fmt: skip
+        sim.observers += [*recorders, series, *later, *extra]
+        sim.run(time=time)
+        runs.append(([r.steps for r in recorders], series.time.tolist(), sum(flown_steps),
+                     sim.particles.position.copy(), [str(o.summary()) for o in later]))  # fmt: skip
+        flown_steps.clear()
+    (fired, samples, flown, position, measured), (stepped_fired, stepped_samples, none, stepped,
+                                                  stepped_measured) = runs  # fmt: skip
+    assert fired == stepped_fired and samples == stepped_samples
+    assert measured == stepped_measured
+    assert len(fired[0]) == 40 and fired[1][0] == 56 and len(samples) == 31  # and t = 0
+    assert flown > 50 and none == 0
+    np.testing.assert_array_equal(position, stepped)
+    sim = cd.load(name)
+    sim.observers.append(StepRecorder(lambda sim: sim.steps % 5 == 0))
+    sim.run(steps=20)
+    assert flown_steps == []
+
+
 def test_a_flight_stops_at_the_step_the_audit_refuses(monkeypatch):
     """A disk outside the vessel (here one made smaller for the audit alone) stops a flown run
     at the same step, with the same words, as a run stepped one by one, and the observers that

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import copy
 import math
-import typing
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,7 +44,7 @@ from collidium.io.checkpoint import read_checkpoint, saved_vessel, write_checkpo
 from collidium.kernels import sums
 from collidium.kernels.audit import first_invalid
 from collidium.kernels.cells import first_overlap, grid_shape, grid_window, window_sides
-from collidium.observers.base import Every, Flown, Observer
+from collidium.observers.base import Every, Flown, Observer, Trigger, fires_at, foreseeable
 from collidium.state import PROPERTIES, FloatArray, IntArray, Particles, as_given, writable
 from collidium.vessels import Vessel, vessel_from_dict
 from collidium.vessels.walls import check_restitution
@@ -419,20 +418,45 @@ class Simulation:
 
     def _run_length(self, left: int) -> int:
         """Steps, up to ``left`` and `MOST_FLOWN`, until an observer reads the state: one unless
-        the integrator can fly here and every trigger is an `Every`. Those that read no more
-        than a flight records (``take_flown``, `collidium.observers.Flown`) do not count."""
+        the integrator can fly here and every trigger is `foreseeable`. Those that read no more
+        than a flight records (``take_flown``, `collidium.observers.Flown`) do not count once
+        they have started (`_reads_state`)."""
         run = min(left, MOST_FLOWN)
-        for observer in self.observers:
-            trigger = observer.trigger
-            if not isinstance(trigger, Every):
-                return 1
-            if not hasattr(observer, "take_flown"):
+        if not all(foreseeable(observer.trigger) for observer in self.observers):
+            return 1
+        readers = [o.trigger for o in self.observers if _reads_state(o)]
+        for trigger in readers:  # the cheap ones first
+            if isinstance(trigger, Every):
                 run = min(run, trigger.period - self.steps % trigger.period)
-        if run > 1 and not self._integrator.flies(
+        if run <= 1 or not self._integrator.flies(
             self.particles, self.container, self._field, self._drift, self.tally
         ):
             return 1
+        for trigger in readers:
+            if not isinstance(trigger, Every):
+                run = self._next_firing(trigger, run)
         return run
+
+    def _next_firing(self, trigger: Trigger, within: int) -> int:
+        """Steps from now to the next firing of a `foreseeable` ``trigger`` if it fires within
+        ``within`` steps, else ``within``; looked for in windows eight times longer each, so
+        that a trigger that fires soon costs little."""
+        done, window = 0, 8
+        while done < within:
+            count = min(window, within) - done
+            steps, times = self._steps_ahead(self.steps + done, count)
+            fires = fires_at(trigger, steps, times, self.dt)
+            if fires.any():
+                return done + int(fires.argmax()) + 1
+            done, window = done + count, 8 * window
+        return within
+
+    def _steps_ahead(self, first: int, count: int) -> tuple[IntArray, FloatArray]:
+        """The ``count`` steps after step ``first`` and the times they end at (s), as `time`
+        counts them."""
+        origin, start = self._time_origin
+        steps = np.arange(first + 1, first + count + 1)
+        return steps, np.asarray(origin + (steps - start) * self.dt, dtype=np.float64)
 
     def _fly(self, run: int) -> int:
         """Up to ``run`` steps in one compiled call; the observers that read no more than its
@@ -447,35 +471,42 @@ class Simulation:
         )  # fmt: skip
         if flown == 0:
             return 0
+        readers = [observer for observer in self.observers if _reads_state(observer)]
+        takers = [observer for observer in self.observers if not _reads_state(observer)]
         self.steps += flown
-        steps = np.arange(first + 1, self.steps + 1)
-        times = np.asarray(origin + (steps - start) * self.dt, dtype=np.float64)  # as `time`
+        steps, times = self._steps_ahead(first, flown)
         # As `_step`: the observers fire after each step that passed the audit. A flight ends at
         # the first step that fails it.
-        self._take_flown(steps[:-1], times[:-1], record)
+        self._take_flown(takers, steps[:-1], times[:-1], record)
         self._audit()
-        self._take_flown(steps[-1:], times[-1:], record, flown - 1)
+        self._take_flown(takers, steps[-1:], times[-1:], record, flown - 1)
         if flown == run:
-            for observer in self.observers:
-                if not hasattr(observer, "take_flown") and observer.trigger(self):
+            for observer in readers:
+                if observer.trigger(self):
                     observer.update(self)
         return flown
 
     def _take_flown(
-        self, steps: IntArray, times: FloatArray, record: FlightRecord, first: int = 0
+        self,
+        takers: list[Observer],
+        steps: IntArray,
+        times: FloatArray,
+        record: FlightRecord,
+        first: int = 0,
     ) -> None:
-        """Hand the observers that take a flight's record (``take_flown``) its rows from
-        ``first`` on, of the ``steps`` at ``times`` (s), at those their trigger fires on."""
+        """Hand the observers that take a flight's record (``takers``, with ``take_flown``) its
+        rows from ``first`` on, of the ``steps`` at ``times`` (s), at those their trigger fires
+        on."""
         rows = slice(first, first + steps.shape[0])
-        for observer in self.observers:
-            if hasattr(observer, "take_flown"):
-                at = steps % typing.cast(Every, observer.trigger).period == 0
-                if at.any():
-                    kinetic, potential, virial, px, py, speed = record.values[rows][at].T
-                    flown = Flown(times[at], kinetic, potential, virial, px, py, speed,
-                                  record.counts[rows][at], record.impulse[rows][at],
-                                  record.heat[rows][at])  # fmt: skip
-                    observer.take_flown(self, flown)
+        for observer in takers:
+            at = fires_at(observer.trigger, steps, times, self.dt)
+            if at.any():
+                kinetic, potential, virial, px, py, speed = record.values[rows][at].T
+                flown = Flown(times[at], kinetic, potential, virial, px, py, speed,
+                              record.counts[rows][at], record.impulse[rows][at],
+                              record.heat[rows][at])  # fmt: skip
+                take = getattr(observer, "take_flown")  # noqa: B009 (not in the protocol)
+                take(self, flown)
 
     def _step(self) -> None:
         try:
@@ -667,6 +698,14 @@ class Simulation:
             f"Simulation({self.name!r}, n={self.particles.n}, {self.container!r}, "
             f"collisions={self.collisions!r}, dt={self.dt}, time={self.time:.6g})"
         )
+
+
+def _reads_state(observer: Observer) -> bool:
+    """Whether ``observer`` reads more of the state than a flight records: it has no
+    ``take_flown``, or it is a measurement yet to start its window (its first sample, under an
+    `After` trigger, also reads what stays fixed over the window, and the energy it starts
+    from)."""
+    return not hasattr(observer, "take_flown") or not getattr(observer, "sampled", True)
 
 
 def restore(path: str | Path) -> Simulation:

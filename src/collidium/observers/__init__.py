@@ -14,6 +14,7 @@ from collidium.observers.base import (
     Measurement,
     Observer,
     Trigger,
+    foreseeable,
 )
 from collidium.observers.counters import CollisionRate
 from collidium.observers.effusion import Effusion
@@ -41,4 +42,5 @@ __all__ = [
     "Tracer",
     "Trigger",
     "VirialRatio",
+    "foreseeable",
 ]

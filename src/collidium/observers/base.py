@@ -4,9 +4,13 @@
 from __future__ import annotations
 
 import math
+import typing
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol, Self, runtime_checkable
+
+import numpy as np
+from numpy.typing import NDArray
 
 from collidium.errors import InputError
 from collidium.state import FloatArray, IntArray
@@ -18,6 +22,8 @@ if TYPE_CHECKING:
 
 #: A trigger is called with the simulation after each step and says whether to fire.
 Trigger = Callable[["Simulation"], bool]
+
+BoolArray = NDArray[np.bool_]
 
 
 def _whole(value: object, field: str, least: int) -> int:
@@ -97,6 +103,34 @@ class After:
         return sim.time >= self.time * (1 - 1e-12) and self.then(sim)
 
 
+@dataclass(frozen=True)
+class _Ahead:
+    """A run's clock at a step to come: all that `Every`, `Interval` and `After` read of it."""
+
+    steps: int
+    time: float
+    dt: float
+
+
+def foreseeable(trigger: Trigger) -> bool:
+    """Whether when ``trigger`` fires depends on the run's clock alone (its steps, time and dt):
+    `Every`, `Interval`, and `After` of such a trigger. A run then knows in advance the steps
+    it fires on (`fires_at`), and flies the steps before them in one call."""
+    if isinstance(trigger, After):
+        return foreseeable(trigger.then)
+    return isinstance(trigger, Every | Interval)
+
+
+def fires_at(trigger: Trigger, steps: IntArray, times: FloatArray, dt: float) -> BoolArray:
+    """Whether a `foreseeable` ``trigger`` fires after each of the ``steps`` (K,), which end at
+    ``times`` (K,) in s (as `collidium.simulation.Simulation.time` counts them), ``dt`` s long."""
+    if isinstance(trigger, Every):
+        return np.asarray(steps % trigger.period == 0)
+    ahead = typing.cast(Callable[[_Ahead], bool], trigger)
+    clocks = zip(steps.tolist(), times.tolist(), strict=True)
+    return np.array([ahead(_Ahead(step, time, dt)) for step, time in clocks], dtype=bool)
+
+
 def as_trigger(trigger: Trigger | int | None) -> Trigger:
     """A trigger from a trigger, a whole number of steps (`Every`) or None (every step)."""
     if trigger is None:
@@ -150,7 +184,7 @@ class Observer(Protocol):
     """What the run loop calls: ``attach`` once before the first step, then ``update`` after each
     step on which ``trigger(sim)`` is true.
 
-    An observer whose trigger is an `Every` and that reads no more than a `Flown` holds may
+    An observer whose trigger is `foreseeable` and that reads no more than a `Flown` holds may
     also have ``take_flown(sim, flown)``: a run then flies the steps between the other
     observers' firings in one compiled call where it can and hands it what it would have read
     at each of its own (`EnergyDrift`, `EnergySeries`, `Thermo`, `CollisionRate` do)."""
