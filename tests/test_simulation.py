@@ -402,19 +402,32 @@ def _spreading() -> cd.Simulation:
     return cd.Simulation(cd.Box(400.0, 400.0), particles, dt=0.01)
 
 
+def _falling_in_a_periodic_box() -> cd.Simulation:
+    """Disks falling through a periodic box: their potential energy takes the unwrapped
+    positions, which change with the images."""
+    rng = np.random.default_rng(3)
+    position = np.array([[x, y] for x in np.linspace(-8, 8, 8) for y in np.linspace(-8, 8, 8)])
+    particles = cd.Particles(position, rng.uniform(-5, 5, position.shape), radius=0.3)
+    box = cd.Box(20.0, 20.0, boundary="periodic")
+    return cd.Simulation(box, particles, forces=[cd.Gravity((0.0, -2.0))], dt=0.01)
+
+
 @pytest.mark.parametrize(
     ("scene", "time"),
     [("gas", 2.0), ("pool-break", 0.5), ("circle-gas", 1.0), ("heat-flow", 1.0),
-     ("granular", 1.0), ("effusion", 1.0), (_spreading, 2.0)],
+     ("granular", 1.0), ("effusion", 1.0), (_spreading, 2.0), ("atmosphere", 1.0),
+     (_falling_in_a_periodic_box, 3.0)],
 )  # fmt: skip
-def test_exact_steps_flown_without_forces_are_bitwise_those_taken_one_by_one(
+def test_exact_steps_flown_without_kicks_are_bitwise_those_taken_one_by_one(
     monkeypatch, scene, time
 ):
-    """Without forces the exact engine flies the steps between the observers that read the
-    state in one compiled call: the run ends bit for bit as one whose observer reads every step,
-    with the same events and queue builds, and the observers that take what a flight records
-    measure bit for bit the same, with walls that give heat (heat-flow), inelastic collisions
-    (granular), segments (effusion) and disks that leave the engine's cell window."""
+    """Without forces, or under a uniform gravity alone that it carries, the exact engine flies
+    the steps between the observers that read the state in one compiled call: the run ends bit
+    for bit as one whose observer reads every step, with the same events and queue builds, and
+    the observers that take what a flight records measure bit for bit the same, with walls that
+    give heat (heat-flow), inelastic collisions (granular), segments (effusion), disks that
+    leave the engine's cell window, and a gravity's potential energy (atmosphere; in a periodic
+    box, of the unwrapped positions)."""
     flown_steps = []
     fly = ExactCollisions.fly
 

@@ -184,8 +184,9 @@ class Drift(Protocol):
         mode when nothing halts it, return None.
         """
 
-    def flies(self, particles: Particles, tally: Tally) -> bool:
-        """Whether `fly` may take steps without forces now."""
+    def flies(self, particles: Particles, tally: Tally, fall: FloatArray) -> bool:
+        """Whether `fly` may take steps now, without forces or under a uniform gravity ``fall``
+        (2,) in m/s^2 (zero for none) that the mode carries."""
 
     def fly(
         self,
@@ -196,13 +197,15 @@ class Drift(Protocol):
         dt: float,
         tally: Tally,
         record: FlightRecord,
+        fall: FloatArray,
     ) -> int:
-        """Drift up to ``len(record)`` steps of ``dt`` (s) without forces in one compiled call,
-        bit for bit as `drift` and the run loop would take them one by one, up to the first that
-        it cannot take; returns how many it took, each recorded in ``record``. Step k starts at
-        ``origin + (elapsed + k) dt``, the simulation's clock. A step that leaves a particle
-        outside the vessel or a value not finite ends the flight, taken, for the run loop's
-        audit to report."""
+        """Drift up to ``len(record)`` steps of ``dt`` (s) in one compiled call, without forces
+        or under the uniform gravity ``fall`` it carries (2,) in m/s^2, bit for bit as `drift`
+        and the run loop would take them one by one, up to the first that it cannot take;
+        returns how many it took, each recorded in ``record`` (with the gravity's potential
+        energy). Step k starts at ``origin + (elapsed + k) dt``, the simulation's clock. A step
+        that leaves a particle outside the vessel or a value not finite ends the flight, taken,
+        for the run loop's audit to report."""
 
     def state(self) -> dict[str, np.ndarray]:
         """Arrays a checkpoint needs to continue bit for bit (empty if the mode keeps none)."""
@@ -289,7 +292,7 @@ class _Stateless:
     def forget(self) -> None:
         """Nothing kept."""
 
-    def flies(self, particles: Particles, tally: Tally) -> bool:
+    def flies(self, particles: Particles, tally: Tally, fall: FloatArray) -> bool:
         """Never: each step is its own call (`Drift.flies`)."""
         return False
 
@@ -302,6 +305,7 @@ class _Stateless:
         dt: float,
         tally: Tally,
         record: FlightRecord,
+        fall: FloatArray,
     ) -> int:
         """No steps (`Drift.fly`)."""
         return 0
@@ -635,10 +639,11 @@ class ExactCollisions:
             self._spare, self._state = self._state, None
         return None
 
-    def flies(self, particles: Particles, tally: Tally) -> bool:
-        """Whether `fly` may take steps now: the queue is built, nobody changed the particles
-        since it wrote them, and the vessel has no piston (`Drift.flies`)."""
-        return tally.piston.size == 0 and self._is_current(particles, tally.piston, _NO_FALL)
+    def flies(self, particles: Particles, tally: Tally, fall: FloatArray) -> bool:
+        """Whether `fly` may take steps now: the queue is built for this ``fall``, nobody
+        changed the particles since it wrote them, and the vessel has no piston
+        (`Drift.flies`)."""
+        return tally.piston.size == 0 and self._is_current(particles, tally.piston, fall)
 
     def fly(
         self,
@@ -649,22 +654,26 @@ class ExactCollisions:
         dt: float,
         tally: Tally,
         record: FlightRecord,
+        fall: FloatArray,
     ) -> int:
-        """Steps without forces in one compiled call (`Drift.fly`,
+        """Steps in one compiled call (`Drift.fly`,
         `collidium.kernels.event_flights.event_intervals`)."""
-        if not self.flies(particles, tally):
+        if not self.flies(particles, tally, fall):
             return 0
         s = self._state
         assert s is not None
         before = (tally.counts.copy(), tally.impulse.copy(), tally.heat.copy())
         self._halt[events.HALT_AFTER] = math.inf
+        fall_x, fall_y = (float(g) for g in fall)
+        width, height = (float(side) for side in vessel.size)
         p = particles
         taken, processed, ending = event_flights.event_intervals(
             origin, elapsed, dt, record.values.shape[0], s["body"], p.image, s["geometry"],
             s["grid"], s["head"], s["next"], s["event"], s["keys"], s["items"], tally.counts,
             tally.impulse, _NO_ACCELERATION, max(1, self.sort_interval * p.n), self._halt,
             vessel.wall_table(), tally.heat, vessel.segments(), s["piston"], p.position,
-            p.velocity, writable(p.mass), writable(p.radius), _runaway_reach(vessel),
+            p.velocity, writable(p.mass), writable(p.radius), fall_x, fall_y, width, height,
+            _runaway_reach(vessel),
             *vessel.audit_arguments(), bool(s["grid"][2]) or _window_is_vessel(s["geometry"],
             s["grid"]), record.values, record.counts, record.impulse, record.heat,
         )  # fmt: skip

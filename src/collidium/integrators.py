@@ -125,11 +125,13 @@ class Integrator:
     def flies(
         self, particles: Particles, vessel: Vessel, field: ForceField, drift: Drift, tally: Tally
     ) -> bool:
-        """Whether `fly` may take steps here: without forces where the drift mode flies
-        (`Drift.flies`), with forces where the integrator does (`_flies_with_forces`)."""
+        """Whether `fly` may take steps here: without forces, or under a uniform gravity alone
+        that the drift carries (`ForceField.falls_alone`), where the drift mode flies
+        (`Drift.flies`); with forces that kick, where the integrator does
+        (`_flies_with_forces`)."""
         if field.kicks:
             return self._flies_with_forces(particles, vessel, field)
-        return not field.active and drift.flies(particles, tally)
+        return (not field.active or field.falls_alone) and drift.flies(particles, tally, field.fall)
 
     def fly(
         self,
@@ -163,9 +165,9 @@ class Integrator:
         if field.kicks:
             return self._fly_with_forces(particles, vessel, field, origin, elapsed, dt, tally,
                                          record)  # fmt: skip
-        if field.active:  # a fall the drift carries: it has a potential energy
+        if field.active and not field.falls_alone:  # the record has no other potential
             return 0
-        return drift.fly(particles, vessel, origin, elapsed, dt, tally, record)
+        return drift.fly(particles, vessel, origin, elapsed, dt, tally, record, field.fall)
 
     def _flies_with_forces(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
         """Whether `_fly_with_forces` may take steps here (none by default)."""

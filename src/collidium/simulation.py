@@ -11,11 +11,11 @@ Run loop, one step of length dt (the reporting interval):
 3. audit: a NaN/infinity or a particle outside the vessel stops the run with `SimulationError`;
 4. observers whose trigger fires (``trigger(sim)``) are updated.
 
-Where the integrator can (`Integrator.fly`: exact collisions without forces, or a small scene
-under a direct pair force), the steps before the next observer that reads the state are taken in
-one compiled call, bit for bit as one by one; observers that read no more than the energies,
-virial, momentum, total speed and tallies (``take_flown``: `collidium.observers.Flown`) get
-those of each of their steps from it.
+Where the integrator can (`Integrator.fly`: exact collisions without forces or under a uniform
+gravity alone, or a small scene under a direct pair force), the steps before the next observer that
+reads the state are taken in one compiled call, bit for bit as one by one; observers that read no
+more than the energies, virial, momentum, total speed and tallies (``take_flown``:
+`collidium.observers.Flown`) get those of each of their steps from it.
 """
 
 from __future__ import annotations

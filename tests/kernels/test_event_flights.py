@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from collidium import Box, Circle, Particles, Simulation, collisions
+from collidium import Box, Circle, Gravity, Particles, Simulation, collisions
 from collidium.collisions import ExactCollisions, FlightRecord
 from collidium.kernels import event_flights, reference
 from lattices import jittered_lattice
@@ -14,14 +14,18 @@ from lattices import jittered_lattice
 STEPS = 7
 
 
-def _gas(rng: np.random.Generator, vessel: Box | Circle, side: float) -> Simulation:
-    """A gas of unequal disks, its queue built by a first step."""
-    position = jittered_lattice(10, side, 0.4, rng)
+def _gas(
+    rng: np.random.Generator, vessel: Box | Circle, side: float, fall: float = 0.0
+) -> Simulation:
+    """A gas of unequal disks, falling with ``fall`` m/s^2 (down), its queue built by a first
+    step."""
+    position = jittered_lattice(8, side, 0.4, rng)
     n = len(position)
     velocity = rng.uniform(-10, 10, (n, 2))
     mass, radius = rng.uniform(0.5, 2.0, n), rng.uniform(0.1, 0.4, n)
     particles = Particles(position, velocity, mass=mass, radius=radius)
-    return Simulation(vessel, particles, dt=0.1).run(steps=1)
+    forces = [Gravity((0.0, -fall))] if fall else []
+    return Simulation(vessel, particles, forces=forces, dt=0.1).run(steps=1)
 
 
 def _fly(sim: Simulation, steps: int = STEPS) -> tuple[int, FlightRecord]:
@@ -30,17 +34,17 @@ def _fly(sim: Simulation, steps: int = STEPS) -> tuple[int, FlightRecord]:
     record = FlightRecord.empty(steps, sim.tally)
     origin, start = sim._time_origin
     flown = drift.fly(sim.particles, sim.container, origin, sim.steps - start, sim.dt, sim.tally,
-                      record)  # fmt: skip
+                      record, sim._field.fall)  # fmt: skip
     return flown, record
 
 
-@pytest.mark.parametrize("shape", ["box", "circle"])
-def test_flown_steps_match_the_twin(rng, shape):
+@pytest.mark.parametrize(("shape", "fall"), [("box", 0.0), ("circle", 0.0), ("box", 5.0)])
+def test_flown_steps_match_the_twin(rng, shape, fall):
     """Steps flown in one call end as the all-pairs twin's steps do, and record at each end the
-    same energies, momentum, total speed, counts and impulses, to the round-off growth of a
-    chaotic gas (`tests/kernels/test_events.py`)."""
+    same energies (of a gravity the engine carries too), momentum, total speed, counts and
+    impulses, to the round-off growth of a chaotic gas (`tests/kernels/test_events.py`)."""
     vessel = Box(20.0, 20.0) if shape == "box" else Circle(10.0)
-    sim = _gas(rng, vessel, 20.0 if shape == "box" else 13.0)
+    sim = _gas(rng, vessel, 20.0 if shape == "box" else 13.0, fall)
     p = sim.particles
     position, velocity = p.position.copy(), p.velocity.copy()
     tally = sim.tally.counts.copy(), sim.tally.impulse.copy()
@@ -48,7 +52,7 @@ def test_flown_steps_match_the_twin(rng, shape):
     half = np.array([10.0, 10.0])
     values, counts, impulses = reference.event_intervals(
         position, velocity, p.mass, p.radius, half, sim.dt, STEPS,
-        rim=10.0 if shape == "circle" else None,
+        rim=10.0 if shape == "circle" else None, fall=np.array([0.0, -fall]),
     )  # fmt: skip
     assert flown == STEPS
     assert counts[-1, 0] > 5 and counts[-1, 1] > 5
@@ -57,6 +61,7 @@ def test_flown_steps_match_the_twin(rng, shape):
     np.testing.assert_array_equal(walls, tally[0][1:].sum() + counts[:, 1])
     np.testing.assert_allclose(record.impulse, tally[1] + impulses, rtol=1e-9)
     np.testing.assert_allclose(record.values, values, rtol=1e-9, atol=1e-9 * values[0, 0])
+    assert (record.values[:, 1] != 0.0).all() == bool(fall)
     np.testing.assert_allclose(p.position, position, rtol=0, atol=1e-9 * 10.0)
     np.testing.assert_allclose(p.velocity, velocity, rtol=0, atol=1e-8 * 10)
     np.testing.assert_array_equal(record.heat, 0.0)

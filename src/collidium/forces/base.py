@@ -294,6 +294,12 @@ class ForceField:
         return bool(self._velocity) or not all(self._carried)
 
     @property
+    def falls_alone(self) -> bool:
+        """True when the field is one force that the drift carries (a uniform gravity alone):
+        its potential energy is then ``-sum m_i fall . x_i`` (`collidium.forces.uniform`)."""
+        return len(self.forces) == 1 and self._carried == (True,)
+
+    @property
     def fall(self) -> FloatArray:
         """The acceleration (2,) in m/s^2 that the drift carries (zero if it carries none)."""
         return self._fall

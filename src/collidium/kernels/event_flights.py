@@ -1,15 +1,17 @@
-"""Whole reporting intervals of the exact engine without forces, compiled.
+"""Whole reporting intervals of the exact engine without forces, or under the uniform gravity
+it carries, compiled.
 
-Without forces the exact engine's queue lives on from step to step (`collidium.kernels.events`),
-and a step of a small scene is a few microseconds of events inside some twenty of Python: the
-drift's checks, the run loop, the audit. `event_intervals` takes many steps in one call, each as
-`collidium.collisions.ExactCollisions.drift` and the run loop take one: the events up to the
-step's end (`events.run_events`), the particles written at it (`events.synchronise`) and audited
-(`collidium.kernels.audit.in_order`), and it records what the observers read at each step's end
-(`collidium.kernels.substeps.RECORD`, and the tallies), so that a run flies the steps between
-the observers that read more of its state. It stops where the drift or the run loop would do
-anything else: a speed that `collidium.collisions` refuses, a particle outside the vessel or a
-value not finite, disks spread out of the cells' window, or time that stops advancing.
+Without forces that kick, the exact engine's queue lives on from step to step
+(`collidium.kernels.events`), and a step of a small scene is a few microseconds of events inside
+some twenty of Python: the drift's checks, the run loop, the audit. `event_intervals` takes many
+steps in one call, each as `collidium.collisions.ExactCollisions.drift` and the run loop take one:
+the events up to the step's end (`events.run_events`), the particles written at it
+(`events.synchronise`) and audited (`collidium.kernels.audit.in_order`), and it records what the
+observers read at each step's end (`collidium.kernels.substeps.RECORD`, and the tallies), so that a
+run flies the steps between the observers that read more of its state. It stops where the drift or
+the run loop would do anything else: a speed that `collidium.collisions` refuses, a particle outside
+the vessel or a value not finite, disks spread out of the cells' window, or time that stops
+advancing.
 """
 
 from __future__ import annotations
@@ -30,10 +32,11 @@ ALL, STOPPED, OUT_OF_WINDOW = range(3)
 def event_intervals(
     origin, elapsed, dt, count, body, image, geometry, grid, head, next_, event, keys, items,
     tally, impulse, acceleration, sort_every, halt, walls, heat, segments, piston, position,
-    velocity, mass, radius, reach, audit_shape, limit_x, limit_y, slack, periodic,
-    window_is_vessel, record, counts, impulses, heats,
+    velocity, mass, radius, fall_x, fall_y, width, height, reach, audit_shape, limit_x, limit_y,
+    slack, periodic, window_is_vessel, record, counts, impulses, heats,
 ) -> tuple[int, int, int]:  # fmt: skip
-    """Up to ``count`` steps of ``dt`` (s) of the exact engine without forces, in place.
+    """Up to ``count`` steps of ``dt`` (s) of the exact engine without forces, or under the one
+    uniform gravity it carries, in place.
 
     Step k runs from ``origin + (elapsed + k) dt`` (the simulation's clock) to the next.
 
@@ -49,17 +52,21 @@ def event_intervals(
         The particles' state (m, m/s), written at each step's end (`events.synchronise`).
     mass, radius : ndarray, shape (N,)
         In kg and m.
+    fall_x, fall_y : float
+        The gravity the engine carries (``geometry``'s), m/s^2: its potential energy
+        ``-sum m_i g . x_i`` is recorded (`collidium.forces.uniform`), with the unwrapped
+        positions in a periodic box of sides ``width`` and ``height`` (m).
     reach : float
-        A step is left to the drift when the largest velocity component (m/s) times ``dt``
-        is not within this distance (m; `collidium.collisions` refuses it then).
+        A step is left to the drift when its largest velocity component (m/s), and what the
+        fall adds over ``dt``, times ``dt`` is not within this distance (m;
+        `collidium.collisions` refuses it then).
     audit_shape, limit_x, limit_y, slack, periodic
         The vessel as `collidium.kernels.audit.first_invalid` takes it (``segments`` too).
     window_is_vessel : bool
         Whether the cells' window covers the vessel (disks outside it are then no reason to
         build the queue again).
     record : ndarray, shape (count, len(RECORD))
-        Output: `collidium.kernels.substeps.RECORD` at each step's end (no potential energy
-        or pair virial without forces: 0).
+        Output: `collidium.kernels.substeps.RECORD` at each step's end (no pair virial: 0).
     counts, impulses, heats : ndarray, shape (count, 1 + W)
         Output: ``tally``, ``impulse`` and ``heat`` at each step's end.
 
@@ -71,9 +78,11 @@ def event_intervals(
         (`events.run_events`; the tallies then hold part of that step).
     """
     processed = 0
+    falls = fall_x != 0.0 or fall_y != 0.0
     for k in range(count):
         now = origin + (elapsed + k) * dt
-        if not _largest_component(velocity) * dt <= reach:  # also NaN
+        speed = _largest_component(velocity) + max(abs(fall_x), abs(fall_y)) * dt
+        if not speed * dt <= reach:  # also NaN
             return k, processed, STOPPED
         until = now + dt
         done = events.run_events(until, body, image, geometry, grid, head, next_, event, keys,
@@ -84,6 +93,9 @@ def event_intervals(
         processed += done
         strays = events.synchronise(until, body, event, geometry, grid, position, velocity)
         _record(k, mass, velocity, tally, impulse, heat, record, counts, impulses, heats)
+        if falls:
+            record[k, 1] = 0.0 + _fall_energy(position, image, mass, fall_x, fall_y, periodic,
+                                              width, height)  # fmt: skip
         invalid, _ = in_order(position, velocity, radius, audit_shape, limit_x, limit_y, slack,
                               periodic, segments)  # fmt: skip
         if invalid >= 0:
@@ -121,3 +133,18 @@ def _record(k, mass, velocity, tally, impulse, heat, record, counts, impulses, h
         counts[k, w] = tally[w]
         impulses[k, w] = impulse[w]
         heats[k, w] = heat[w]
+
+
+@numba.njit(cache=True)
+def _fall_energy(position, image, mass, fall_x, fall_y, periodic, width, height) -> float:
+    """``-sum m_i g . x_i`` (J) in particle order, as `collidium.forces.uniform` gives each
+    particle's and `collidium.kernels.sums.ordered_sum` adds them: the unwrapped position in a
+    periodic box."""
+    total = 0.0
+    for i in range(position.shape[0]):
+        x, y = position[i, 0], position[i, 1]
+        if periodic:
+            x = x + image[i, 0] * width
+            y = y + image[i, 1] * height
+        total += -(x * (mass[i] * fall_x) + y * (mass[i] * fall_y))
+    return total

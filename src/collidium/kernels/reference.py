@@ -231,24 +231,28 @@ def event_intervals(
     dt: float,
     count: int,
     rim: float | None = None,
+    fall: FloatArray | None = None,
 ) -> tuple[FloatArray, IntArray, FloatArray]:
     """Twin of `event_flights.event_intervals`: `event_drift` for ``count`` steps of ``dt`` (s)
-    in a box of half sides ``half`` or a circle of radius ``rim`` (m), in place, recording at
-    each step's end the kinetic energy, potential energy and pair virial (0), momentum, total
+    in a box of half sides ``half`` or a circle of radius ``rim`` (m), falling with ``fall``
+    (2,) m/s^2 (none by default), in place, recording at each step's end the kinetic energy,
+    the potential energy of the fall ``-sum m g . x``, the pair virial (0), momentum, total
     speed (K, 6); the pair collisions and wall hits (K, 2); the collision virial and the
     momentum each wall received (K, 1 + W)."""
+    g = np.zeros(2) if fall is None else np.asarray(fall, dtype=float)
     values, counts, impulses = [], [], []
     pairs = walls = 0
     virial = 0.0
     received = np.zeros(1 if rim is not None else 4)
     for _ in range(count):
-        more = event_drift(position, velocity, mass, radius, half, dt, rim=rim)
+        more = event_drift(position, velocity, mass, radius, half, dt, rim=rim, fall=g)
         pairs, walls, virial = pairs + more[0], walls + more[1], virial + more[2]
         received = received + more[3]
         px, py = mass @ velocity
         kinetic = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1)))
         speeds = float(np.sum(np.hypot(velocity[:, 0], velocity[:, 1])))
-        values.append((kinetic, 0.0, 0.0, float(px), float(py), speeds))
+        potential = -float(np.sum(mass * (position @ g)))
+        values.append((kinetic, potential, 0.0, float(px), float(py), speeds))
         counts.append((pairs, walls))
         impulses.append((virial, *received))
     return np.array(values), np.array(counts, dtype=np.int64), np.array(impulses)

@@ -147,9 +147,9 @@ def as_trigger(trigger: Trigger | int | None) -> Trigger:
 @dataclass(frozen=True)
 class Flown:
     """What a run records of the steps it flew in one compiled call (`Simulation.run`: exact
-    collisions without forces, or a small charged scene), at those an observer's trigger fired
-    on, as `Simulation` gives them at each. The vessel did not change in between (a flight
-    has no piston). Arrays of K rows, one per step.
+    collisions without forces or under a gravity alone, or a small charged scene), at those an
+    observer's trigger fired on, as `Simulation` gives them at each. The vessel did not change in
+    between (a flight has no piston). Arrays of K rows, one per step.
 
     Attributes
     ----------
