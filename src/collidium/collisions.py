@@ -26,7 +26,7 @@ from collidium.kernels import event_flights, events, stepper
 from collidium.kernels.cells import bounding_box, event_grid_shape, grid_window, window_sides
 from collidium.kernels.substeps import RECORD
 from collidium.kernels.vessels import piston as piston_kernels
-from collidium.state import FloatArray, IntArray, Particles, as_given, writable
+from collidium.state import BoolArray, FloatArray, IntArray, Particles, as_given, writable
 from collidium.vessels import Vessel
 from collidium.vessels.walls import wall_axis
 
@@ -96,25 +96,30 @@ class FlightRecord:
     ----------
     values : ndarray, shape (K, len(collidium.kernels.substeps.RECORD))
         The kinetic and potential energy and the pair virial (J), the momentum (kg m/s) and the
-        sum of the speeds (m/s), as `collidium.simulation.Simulation` sums them.
+        sum of the speeds (m/s), as `collidium.simulation.Simulation` sums them; a flight may
+        leave the rows of the steps not ``wanted`` unwritten.
     counts, impulse, heat : ndarray, shape (K, 1 + W)
         The `Tally`'s.
+    wanted : ndarray of bool, shape (K,)
+        The steps whose ``values`` an observer reads.
     """
 
     values: FloatArray
     counts: IntArray
     impulse: FloatArray
     heat: FloatArray
+    wanted: BoolArray
 
     @classmethod
-    def empty(cls, steps: int, tally: Tally) -> FlightRecord:
-        """Rows for ``steps`` steps of a vessel with ``tally``'s walls, not yet written."""
-        size = tally.counts.shape[0]
+    def empty(cls, tally: Tally, wanted: BoolArray) -> FlightRecord:
+        """Rows for ``len(wanted)`` steps of a vessel with ``tally``'s walls, not yet written."""
+        steps, size = wanted.shape[0], tally.counts.shape[0]
         return cls(
             np.empty((steps, len(RECORD))),
             np.empty((steps, size), dtype=np.int64),
             np.empty((steps, size)),
             np.empty((steps, size)),
+            wanted,
         )
 
     def tally_of_now(self, steps: int, tally: Tally) -> None:
@@ -675,7 +680,7 @@ class ExactCollisions:
             p.velocity, writable(p.mass), writable(p.radius), fall_x, fall_y, width, height,
             _runaway_reach(vessel),
             *vessel.audit_arguments(), bool(s["grid"][2]) or _window_is_vessel(s["geometry"],
-            s["grid"]), record.values, record.counts, record.impulse, record.heat,
+            s["grid"]), record.values, record.counts, record.impulse, record.heat, record.wanted,
         )  # fmt: skip
         self.events += processed
         if taken:

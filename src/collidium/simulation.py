@@ -45,7 +45,15 @@ from collidium.kernels import sums
 from collidium.kernels.audit import first_invalid
 from collidium.kernels.cells import first_overlap, grid_shape, grid_window, window_sides
 from collidium.observers.base import Every, Flown, Observer, Trigger, fires_at, foreseeable
-from collidium.state import PROPERTIES, FloatArray, IntArray, Particles, as_given, writable
+from collidium.state import (
+    PROPERTIES,
+    BoolArray,
+    FloatArray,
+    IntArray,
+    Particles,
+    as_given,
+    writable,
+)
 from collidium.vessels import Vessel, vessel_from_dict
 from collidium.vessels.walls import check_restitution
 
@@ -462,24 +470,28 @@ class Simulation:
         """Up to ``run`` steps in one compiled call; the observers that read no more than its
         record get what they would have read on each step they fire on, and after the last
         step, if it was taken, the others fire as after any step. Returns the steps taken."""
-        record = FlightRecord.empty(run, self.tally)
         first = self.steps
         origin, start = self._time_origin
+        steps, times = self._steps_ahead(first, run)
+        readers = [observer for observer in self.observers if _reads_state(observer)]
+        takers = [(observer, fires_at(observer.trigger, steps, times, self.dt))
+                  for observer in self.observers if not _reads_state(observer)]  # fmt: skip
+        wanted = np.zeros(run, dtype=bool)
+        for _, fires in takers:
+            wanted |= fires
+        record = FlightRecord.empty(self.tally, wanted)
         flown = self._integrator.fly(
             self.particles, self.container, self._field, self._drift, origin, first - start,
             self.dt, self.tally, record,
         )  # fmt: skip
         if flown == 0:
             return 0
-        readers = [observer for observer in self.observers if _reads_state(observer)]
-        takers = [observer for observer in self.observers if not _reads_state(observer)]
         self.steps += flown
-        steps, times = self._steps_ahead(first, flown)
         # As `_step`: the observers fire after each step that passed the audit. A flight ends at
         # the first step that fails it.
-        self._take_flown(takers, steps[:-1], times[:-1], record)
+        self._take_flown(takers, times, record, 0, flown - 1)
         self._audit()
-        self._take_flown(takers, steps[-1:], times[-1:], record, flown - 1)
+        self._take_flown(takers, times, record, flown - 1, flown)
         if flown == run:
             for observer in readers:
                 if observer.trigger(self):
@@ -488,21 +500,21 @@ class Simulation:
 
     def _take_flown(
         self,
-        takers: list[Observer],
-        steps: IntArray,
+        takers: list[tuple[Observer, BoolArray]],
         times: FloatArray,
         record: FlightRecord,
-        first: int = 0,
+        first: int,
+        stop: int,
     ) -> None:
-        """Hand the observers that take a flight's record (``takers``, with ``take_flown``) its
-        rows from ``first`` on, of the ``steps`` at ``times`` (s), at those their trigger fires
-        on."""
-        rows = slice(first, first + steps.shape[0])
-        for observer in takers:
-            at = fires_at(observer.trigger, steps, times, self.dt)
+        """Hand the observers that take a flight's record (``takers``, with ``take_flown``, and
+        the steps each fires on) the record's rows ``first`` to ``stop - 1`` of the steps that
+        end at ``times`` (s), at those they fire on."""
+        rows = slice(first, stop)
+        for observer, fires in takers:
+            at = fires[rows]
             if at.any():
                 kinetic, potential, virial, px, py, speed = record.values[rows][at].T
-                flown = Flown(times[at], kinetic, potential, virial, px, py, speed,
+                flown = Flown(times[rows][at], kinetic, potential, virial, px, py, speed,
                               record.counts[rows][at], record.impulse[rows][at],
                               record.heat[rows][at])  # fmt: skip
                 take = getattr(observer, "take_flown")  # noqa: B009 (not in the protocol)

@@ -31,7 +31,7 @@ def _gas(
 def _fly(sim: Simulation, steps: int = STEPS) -> tuple[int, FlightRecord]:
     drift = sim._drift
     assert isinstance(drift, ExactCollisions)
-    record = FlightRecord.empty(steps, sim.tally)
+    record = FlightRecord.empty(sim.tally, np.ones(steps, dtype=bool))
     origin, start = sim._time_origin
     flown = drift.fly(sim.particles, sim.container, origin, sim.steps - start, sim.dt, sim.tally,
                       record, sim._field.fall)  # fmt: skip

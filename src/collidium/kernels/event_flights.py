@@ -33,7 +33,7 @@ def event_intervals(
     origin, elapsed, dt, count, body, image, geometry, grid, head, next_, event, keys, items,
     tally, impulse, acceleration, sort_every, halt, walls, heat, segments, piston, position,
     velocity, mass, radius, fall_x, fall_y, width, height, reach, audit_shape, limit_x, limit_y,
-    slack, periodic, window_is_vessel, record, counts, impulses, heats,
+    slack, periodic, window_is_vessel, record, counts, impulses, heats, wanted,
 ) -> tuple[int, int, int]:  # fmt: skip
     """Up to ``count`` steps of ``dt`` (s) of the exact engine without forces, or under the one
     uniform gravity it carries, in place.
@@ -66,9 +66,12 @@ def event_intervals(
         Whether the cells' window covers the vessel (disks outside it are then no reason to
         build the queue again).
     record : ndarray, shape (count, len(RECORD))
-        Output: `collidium.kernels.substeps.RECORD` at each step's end (no pair virial: 0).
+        Output: `collidium.kernels.substeps.RECORD` at the end of each step ``wanted`` (no pair
+        virial: 0); the other rows are left as they are.
     counts, impulses, heats : ndarray, shape (count, 1 + W)
         Output: ``tally``, ``impulse`` and ``heat`` at each step's end.
+    wanted : ndarray of bool, shape (count,)
+        The steps whose ``record`` an observer reads.
 
     Returns
     -------
@@ -92,10 +95,12 @@ def event_intervals(
             return k, processed, done
         processed += done
         strays = events.synchronise(until, body, event, geometry, grid, position, velocity)
-        _record(k, mass, velocity, tally, impulse, heat, record, counts, impulses, heats)
-        if falls:
-            record[k, 1] = 0.0 + _fall_energy(position, image, mass, fall_x, fall_y, periodic,
-                                              width, height)  # fmt: skip
+        _tallies(k, tally, impulse, heat, counts, impulses, heats)
+        if wanted[k]:
+            _record(k, mass, velocity, record)
+            if falls:
+                record[k, 1] = 0.0 + _fall_energy(position, image, mass, fall_x, fall_y,
+                                                  periodic, width, height)  # fmt: skip
         invalid, _ = in_order(position, velocity, radius, audit_shape, limit_x, limit_y, slack,
                               periodic, segments)  # fmt: skip
         if invalid >= 0:
@@ -120,8 +125,8 @@ def _largest_component(velocity) -> float:
 
 
 @numba.njit(cache=True)
-def _record(k, mass, velocity, tally, impulse, heat, record, counts, impulses, heats) -> None:
-    """Row k of the records: `collidium.kernels.substeps.RECORD` and the tallies."""
+def _record(k, mass, velocity, record) -> None:
+    """Row k of `collidium.kernels.substeps.RECORD`, without forces."""
     px, py = momentum(mass, velocity)
     record[k, 0] = kinetic_energy(mass, velocity)
     record[k, 1] = 0.0
@@ -129,6 +134,11 @@ def _record(k, mass, velocity, tally, impulse, heat, record, counts, impulses, h
     record[k, 3] = px
     record[k, 4] = py
     record[k, 5] = total_speed(velocity)
+
+
+@numba.njit(cache=True)
+def _tallies(k, tally, impulse, heat, counts, impulses, heats) -> None:
+    """Row k of the tallies' records."""
     for w in range(tally.shape[0]):
         counts[k, w] = tally[w]
         impulses[k, w] = impulse[w]

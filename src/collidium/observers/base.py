@@ -10,10 +10,9 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol, Self, runtime_checkable
 
 import numpy as np
-from numpy.typing import NDArray
 
 from collidium.errors import InputError
-from collidium.state import FloatArray, IntArray
+from collidium.state import BoolArray, FloatArray, IntArray
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -22,8 +21,6 @@ if TYPE_CHECKING:
 
 #: A trigger is called with the simulation after each step and says whether to fire.
 Trigger = Callable[["Simulation"], bool]
-
-BoolArray = NDArray[np.bool_]
 
 
 def _whole(value: object, field: str, least: int) -> int:
