@@ -204,13 +204,13 @@ class Drift(Protocol):
         record: FlightRecord,
         fall: FloatArray,
     ) -> int:
-        """Drift up to ``len(record)`` steps of ``dt`` (s) in one compiled call, without forces
-        or under the uniform gravity ``fall`` it carries (2,) in m/s^2, bit for bit as `drift`
-        and the run loop would take them one by one, up to the first that it cannot take;
-        returns how many it took, each recorded in ``record`` (with the gravity's potential
-        energy). Step k starts at ``origin + (elapsed + k) dt``, the simulation's clock. A step
-        that leaves a particle outside the vessel or a value not finite ends the flight, taken,
-        for the run loop's audit to report."""
+        """Drift up to ``len(record.values)`` steps of ``dt`` (s) in one compiled call, without
+        forces or under the uniform gravity ``fall`` it carries (2,) in m/s^2, bit for bit as
+        `drift` and the run loop would take them one by one, up to the first that it cannot take;
+        returns how many it took, each recorded in ``record`` (with the gravity's potential energy).
+        Step k starts at ``origin + (elapsed + k) dt``, the simulation's clock. A step that leaves a
+        particle outside the vessel or a value not finite ends the flight, taken, for the run loop's
+        audit to report."""
 
     def state(self) -> dict[str, np.ndarray]:
         """Arrays a checkpoint needs to continue bit for bit (empty if the mode keeps none)."""
