@@ -712,7 +712,8 @@ def first_contact(gap: float, rate: float, pull: float) -> float:
     t = 0 a gap that only starts to open does not), by `numpy.roots`; inf if none."""
     gap = max(gap, 0.0)
     if pull == 0.0:  # a straight path: one division (np.roots overflows for tiny rates)
-        return gap / -rate if rate < 0.0 else math.inf
+        with np.errstate(over="ignore"):  # a tiny rate: inf, as the kernel gives
+            return gap / -rate if rate < 0.0 else math.inf
     roots = np.roots([0.5 * pull, rate, gap])
     closing = []
     for root in np.atleast_1d(roots):
