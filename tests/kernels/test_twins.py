@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from collidium.kernels import reference
-from collidium.kernels.audit import first_invalid
+from collidium.kernels.audit import all_valid, first_invalid
 from collidium.kernels.placement import place_disks
 from collidium.kernels.vessels import BOX, CIRCLE
 from collidium.kernels.vessels.box import DRIFT_CHUNK, drift_periodic, drift_reflecting, fold
@@ -66,13 +66,15 @@ def test_placement_equals_twin(rng):
 @pytest.mark.parametrize(("shape", "periodic"), [(BOX, False), (BOX, True), (CIRCLE, False)])
 def test_audit_equals_twin(rng, shape, periodic, n):
     """In one pass, or in parallel chunks (4 at N = 20,000): the first bad particle is found,
-    wherever the bad ones lie, in a box of half side 5 m or a circle of radius 5 m."""
+    wherever the bad ones lie, in a box of half side 5 m or a circle of radius 5 m; the flights'
+    audit (`all_valid`, without branches in a box) says whether there is one."""
     position = rng.uniform(-3.5, 3.5, (n, 2))
     velocity = rng.normal(0, 1, (n, 2))
     radius = np.full(n, 0.05)
     limit = 5.0 * (1 + 1e-9)
     args = (shape, limit, limit, 0.0, periodic, NONE)
     assert first_invalid(position, velocity, radius, *args) == (-1, 0)
+    assert all_valid(position, velocity, radius, *args)
     two_chunks = [(3 * n // 5, "position", [0.0, -5.2]), (n // 4 + 1, "velocity", [0.0, np.inf])]
     corner = [(7, "position", [3.6, 3.6])]  # inside the box, outside the circle
     cases = [[(57, "position", [4.97, 0.0])], [(n - 1, "velocity", [np.nan, 0.0])], two_chunks]
@@ -82,6 +84,7 @@ def test_audit_equals_twin(rng, shape, periodic, n):
             (p if field == "position" else v)[index] = value
         want = reference.first_invalid(p, v, radius, *args)
         assert first_invalid(p, v, radius, *args) == want
+        assert all_valid(p, v, radius, *args) == (want[0] < 0)
         found = min(index for index, *_ in bad)
         inside = (periodic and bad[0][0] == 57) or (shape == BOX and bad is corner)
         assert want[0] == (-1 if inside and len(bad) == 1 else found)

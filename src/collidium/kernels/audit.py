@@ -8,7 +8,7 @@ import numba
 import numpy as np
 
 from collidium.kernels.stepper import chunk_count
-from collidium.kernels.vessels import contacts
+from collidium.kernels.vessels import BOX, box, contacts
 
 #: Particles from which the audit runs in parallel chunks; below, starting the threads would cost
 #: more than the pass (a two-disk scene took twice as long a step).
@@ -62,6 +62,24 @@ def in_order(position, velocity, radius, shape, limit_x, limit_y, slack, periodi
     """`first_invalid` in one pass, particle by particle, compiled: ``(index, reason)``."""
     return _first_between(0, position.shape[0], position, velocity, radius, shape, limit_x,
                           limit_y, slack, periodic, segments)  # fmt: skip
+
+
+@numba.njit(cache=True)
+def all_valid(position, velocity, radius, shape, limit_x, limit_y, slack, periodic, segments):
+    """Whether no particle fails the audit (`first_invalid`; its arguments), compiled, for the
+    steps a run flies (`collidium.kernels.event_flights`). In a box without segments one pass
+    without branches, which LLVM vectorises (0.5 against 3.5 us for 200 disks); `in_order`
+    otherwise (a circle's branch-free pass, tried, was no faster)."""
+    if shape != BOX or segments.shape[0] > 0:
+        return in_order(position, velocity, radius, shape, limit_x, limit_y, slack, periodic,
+                        segments)[0] < 0  # fmt: skip
+    bad = False
+    for i in range(position.shape[0]):
+        x, y, vx, vy = position[i, 0], position[i, 1], velocity[i, 0], velocity[i, 1]
+        finite = (x - x == 0.0) & (y - y == 0.0) & (vx - vx == 0.0) & (vy - vy == 0.0)  # NaN else
+        reach = 0.0 if periodic else radius[i]
+        bad |= (not finite) | box.reaches_outside(x, y, reach, limit_x, limit_y)
+    return not bad
 
 
 @numba.njit(cache=True, parallel=True)

@@ -6,7 +6,7 @@ Without forces that kick, the exact engine's queue lives on from step to step
 some twenty of Python: the drift's checks, the run loop, the audit. `event_intervals` takes many
 steps in one call, each as `collidium.collisions.ExactCollisions.drift` and the run loop take one:
 the events up to the step's end (`events.run_events`), the particles written at it
-(`events.synchronise`) and audited (`collidium.kernels.audit.in_order`), and it records what the
+(`events.synchronise`) and audited (`collidium.kernels.audit.all_valid`), and it records what the
 observers read at each step's end (`collidium.kernels.substeps.RECORD`, and the tallies), so that a
 run flies the steps between the observers that read more of its state. It stops where the drift or
 the run loop would do anything else: a speed that `collidium.collisions` refuses, a particle outside
@@ -19,7 +19,7 @@ from __future__ import annotations
 import numba
 
 from collidium.kernels import events
-from collidium.kernels.audit import in_order
+from collidium.kernels.audit import all_valid
 from collidium.kernels.sums import kinetic_energy, momentum, total_speed
 
 #: How `event_intervals` ended: every interval taken; at an interval that the drift must take
@@ -101,9 +101,8 @@ def event_intervals(
             if falls:
                 record[k, 1] = 0.0 + _fall_energy(position, image, mass, fall_x, fall_y,
                                                   periodic, width, height)  # fmt: skip
-        invalid, _ = in_order(position, velocity, radius, audit_shape, limit_x, limit_y, slack,
-                              periodic, segments)  # fmt: skip
-        if invalid >= 0:
+        if not all_valid(position, velocity, radius, audit_shape, limit_x, limit_y, slack,
+                         periodic, segments):  # fmt: skip
             return k + 1, processed, STOPPED
         if strays > 0 and not window_is_vessel:
             return k + 1, processed, OUT_OF_WINDOW
