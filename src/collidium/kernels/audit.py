@@ -7,6 +7,7 @@ import math
 import numba
 import numpy as np
 
+from collidium.kernels.compilation import uncounted
 from collidium.kernels.stepper import chunk_count
 from collidium.kernels.vessels import BOX, box, contacts
 
@@ -57,14 +58,14 @@ def first_invalid(
     return int(index), int(reason)
 
 
-@numba.njit(cache=True)
+@uncounted()
 def in_order(position, velocity, radius, shape, limit_x, limit_y, slack, periodic, segments):
     """`first_invalid` in one pass, particle by particle, compiled: ``(index, reason)``."""
     return _first_between(0, position.shape[0], position, velocity, radius, shape, limit_x,
                           limit_y, slack, periodic, segments)  # fmt: skip
 
 
-@numba.njit(cache=True)
+@uncounted()
 def all_valid(position, velocity, radius, shape, limit_x, limit_y, slack, periodic, segments):
     """Whether no particle fails the audit (`first_invalid`; its arguments), compiled, for the
     steps a run flies (`collidium.kernels.event_flights`). In a box without segments one pass

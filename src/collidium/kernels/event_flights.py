@@ -16,10 +16,9 @@ advancing.
 
 from __future__ import annotations
 
-import numba
-
 from collidium.kernels import events
 from collidium.kernels.audit import all_valid
+from collidium.kernels.compilation import uncounted
 from collidium.kernels.sums import kinetic_energy, momentum, total_speed
 
 #: How `event_intervals` ended: every interval taken; at an interval that the drift must take
@@ -28,7 +27,7 @@ from collidium.kernels.sums import kinetic_energy, momentum, total_speed
 ALL, STOPPED, OUT_OF_WINDOW = range(3)
 
 
-@numba.njit(cache=True)
+@uncounted()
 def event_intervals(
     origin, elapsed, dt, count, body, image, geometry, grid, head, next_, event, keys, items,
     tally, impulse, acceleration, sort_every, halt, walls, heat, segments, piston, position,
@@ -109,7 +108,7 @@ def event_intervals(
     return count, processed, ALL
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _largest_component(velocity) -> float:
     """``max |v_i,d|`` over the particles and axes (m/s), as ``collidium.collisions`` takes it
     from NumPy's maximum and minimum: NaN if any is NaN."""
@@ -123,7 +122,7 @@ def _largest_component(velocity) -> float:
     return largest
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _record(k, mass, velocity, record) -> None:
     """Row k of `collidium.kernels.substeps.RECORD`, without forces."""
     px, py = momentum(mass, velocity)
@@ -135,7 +134,7 @@ def _record(k, mass, velocity, record) -> None:
     record[k, 5] = total_speed(velocity)
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _tallies(k, tally, impulse, heat, counts, impulses, heats) -> None:
     """Row k of the tallies' records."""
     for w in range(tally.shape[0]):
@@ -144,7 +143,7 @@ def _tallies(k, tally, impulse, heat, counts, impulses, heats) -> None:
         heats[k, w] = heat[w]
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _fall_energy(position, image, mass, fall_x, fall_y, periodic, width, height) -> float:
     """``-sum m_i g . x_i`` (J) in particle order, as `collidium.forces.uniform` gives each
     particle's and `collidium.kernels.sums.ordered_sum` adds them: the unwrapped position in a

@@ -26,6 +26,8 @@ import numpy as np
 from numba import types
 from numba.extending import intrinsic
 
+from collidium.kernels.compilation import uncounted
+
 #: Reassociation (partial sums per vector lane) and fused multiply-add, nothing else. The row
 #: loops also use NumPy's error model (a division by zero gives inf, as in the parallel kernel),
 #: without which a zero-division check in the loop would keep it from being vectorised.
@@ -166,7 +168,7 @@ def _blocks(m: int) -> tuple[int, int, int]:
     return size, blocks, (blocks + 1) // 2
 
 
-@numba.njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+@uncounted(fastmath=_FASTMATH, error_model="numpy")
 def _tile(first, second, size, x, y, q, coupling, softening2, width, height, periodic, sums):
     """The pairs of block ``first`` with block ``second`` (each pair of the block once when they
     are the same), added to both particles' ``sums`` (4, m): force x, y, pair energy, ``r . F``.
@@ -208,7 +210,7 @@ def _tile(first, second, size, x, y, q, coupling, softening2, width, height, per
         sums[3, i] += w
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums) -> None:
     """Task t of the pair sums: the tiles of block rows t and ``blocks - 1 - t`` (each tile of a
     row with itself and the blocks after it) into its own ``sums`` (4, m), zeroed first."""
@@ -239,7 +241,7 @@ def _zero(sums) -> None:
             sums[d, c] = 0.0
 
 
-@numba.njit(cache=True)
+@uncounted()
 def pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buffer) -> None:
     """Every pair's force x, y, energy and ``r . F`` on both particles into ``sums`` (4, m),
     each pair once, on the calling thread: task by task, each in a buffer of its own, the

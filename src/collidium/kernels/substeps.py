@@ -26,6 +26,7 @@ import math
 import numba
 import numpy as np
 
+from collidium.kernels.compilation import uncounted
 from collidium.kernels.pairwise import MOST_BLOCKS, larger, pair_sums, stiffness_row
 from collidium.kernels.sorting import sort_nearly_sorted
 from collidium.kernels.sums import kinetic_energy, momentum, total_speed
@@ -230,7 +231,7 @@ def _work(mass, source):
     return motion + (index, charged, inverse_mass) + rows + sums + sweep  # noqa: RUF005
 
 
-@numba.njit(cache=True, error_model="numpy")
+@uncounted(error_model="numpy")
 def _substeps(position, velocity, acceleration, mass, radius, coupling, softening2, walls, now,
               dt, first, count, t, fastest, total, energy_floor, work):  # fmt: skip
     """`smooth_substeps` in its work arrays (`_work`), the vessel as one tuple."""
@@ -271,7 +272,7 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     return count + 1, t, fastest
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _keep(position, velocity, acceleration, start) -> None:
     """The motion into ``start`` (3, N, 2), to take an interval again."""
     for i in range(position.shape[0]):
@@ -281,7 +282,7 @@ def _keep(position, velocity, acceleration, start) -> None:
             start[2, i, d] = acceleration[i, d]
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _restore(position, velocity, acceleration, start) -> None:
     """The motion back from ``start`` (`_keep`)."""
     for i in range(position.shape[0]):
@@ -329,7 +330,7 @@ def _accelerations(position, mass, coupling, softening2, index, charged, x, y, s
         out[i, 1] /= mass[i]
 
 
-@numba.njit(cache=True, error_model="numpy")
+@uncounted(error_model="numpy")
 def _energies(position, coupling, softening2, sources) -> tuple[float, float]:
     """The potential energy and the pair virial (J) of the pair force: its pair sums halved to
     the particles and summed in particle order, as `collidium.forces.base.ForceField` sums them
@@ -345,7 +346,7 @@ def _energies(position, coupling, softening2, sources) -> tuple[float, float]:
     return 0.0 + energy, 0.0 + virial  # the field adds its forces' sums to 0
 
 
-@numba.njit(cache=True, error_model="numpy")
+@uncounted(error_model="numpy")
 def _squared_rate(position, velocity, mass, coupling, softening2, total, floor, sources) -> float:
     """`_rate` with the arrays of `_work` from the indices to the sums' buffer (``sources``)."""
     index, charged, inverse_mass, x, y, vx, vy, _, _ = sources

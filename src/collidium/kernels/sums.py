@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
+from collidium.kernels.compilation import uncounted
 
-@numba.njit(cache=True)
+
+@uncounted()
 def kinetic_energy(mass: np.ndarray, velocity: np.ndarray) -> float:
     """``sum m v^2 / 2`` in J of masses (N,) in kg and velocities (N, 2) in m/s."""
     total = 0.0
@@ -24,7 +25,7 @@ def kinetic_energy(mass: np.ndarray, velocity: np.ndarray) -> float:
     return 0.5 * total
 
 
-@numba.njit(cache=True)
+@uncounted()
 def momentum(mass: np.ndarray, velocity: np.ndarray) -> tuple[float, float]:
     """``sum m v``, (x, y) in kg m/s, of masses (N,) in kg and velocities (N, 2) in m/s."""
     px = 0.0
@@ -35,7 +36,7 @@ def momentum(mass: np.ndarray, velocity: np.ndarray) -> tuple[float, float]:
     return px, py
 
 
-@numba.njit(cache=True)
+@uncounted()
 def total_speed(velocity: np.ndarray) -> float:
     """``sum |v|`` in m/s of velocities (N, 2) in m/s."""
     total = 0.0
@@ -44,7 +45,7 @@ def total_speed(velocity: np.ndarray) -> float:
     return total
 
 
-@numba.njit(cache=True)
+@uncounted()
 def ordered_sum(values: np.ndarray) -> float:
     """The sum of ``values`` (N,) in index order, from 0."""
     total = 0.0
