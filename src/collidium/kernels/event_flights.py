@@ -19,6 +19,7 @@ from __future__ import annotations
 from collidium.kernels import events
 from collidium.kernels.audit import all_valid
 from collidium.kernels.compilation import uncounted
+from collidium.kernels.floats import largest_magnitude
 from collidium.kernels.sums import kinetic_energy, momentum, total_speed
 
 #: How `event_intervals` ended: every interval taken; at an interval that the drift must take
@@ -83,7 +84,7 @@ def event_intervals(
     falls = fall_x != 0.0 or fall_y != 0.0
     for k in range(count):
         now = origin + (elapsed + k) * dt
-        speed = _largest_component(velocity) + max(abs(fall_x), abs(fall_y)) * dt
+        speed = largest_magnitude(velocity) + max(abs(fall_x), abs(fall_y)) * dt
         if not speed * dt <= reach:  # also NaN
             return k, processed, STOPPED
         until = now + dt
@@ -106,20 +107,6 @@ def event_intervals(
         if strays > 0 and not window_is_vessel:
             return k + 1, processed, OUT_OF_WINDOW
     return count, processed, ALL
-
-
-@uncounted()
-def _largest_component(velocity) -> float:
-    """``max |v_i,d|`` over the particles and axes (m/s), as ``collidium.collisions`` takes it
-    from NumPy's maximum and minimum: NaN if any is NaN."""
-    largest = 0.0
-    for i in range(velocity.shape[0]):
-        for d in range(2):
-            size = abs(velocity[i, d])
-            if size != size:  # NaN
-                return size
-            largest = max(largest, size)
-    return largest
 
 
 @uncounted()

@@ -18,15 +18,13 @@ relaxed (no approximate functions, no assumptions about infinities or NaN).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from typing import Any, cast
+from typing import Any
 
 import numba
 import numpy as np
-from numba import types
-from numba.extending import intrinsic
 
 from collidium.kernels.compilation import uncounted
+from collidium.kernels.floats import MAGNITUDE, bits, from_bits
 
 #: Reassociation (partial sums per vector lane) and fused multiply-add, nothing else. The row
 #: loops also use NumPy's error model (a division by zero gives inf, as in the parallel kernel),
@@ -342,9 +340,8 @@ def stiffness_row(
     reference counting per substep."""
     xc, yc, vxc, vyc = x[c], y[c], vx[c], vy[c]
     kqc, mc = abs(coupling * q[c]), inverse_mass[c]
-    # The maximum of non-negative floats as that of their bit patterns, which order alike: LLVM
-    # vectorises an integer maximum, not a float one. Without the sign bit a NaN is the largest
-    # pattern, and is kept.
+    # The maximum of non-negative floats as that of their bit patterns (`floats`): vectorised,
+    # and a NaN is kept.
     largest = 0
     for j in range(_u(c + 1), _u(x.shape[0])):  # unsigned: see `_tile`
         dx = xc - x[j]
@@ -358,8 +355,8 @@ def stiffness_row(
         u = kqc * abs(q[j]) * inverse
         w2 = dvx * dvx + dvy * dvy
         error = u * (w2 + u * (mc + inverse_mass[j])) * inverse * inverse
-        largest = max(largest, _bits(error * error) & _MAGNITUDE)
-    return _float(largest)
+        largest = max(largest, bits(error * error) & MAGNITUDE)
+    return from_bits(largest)
 
 
 @numba.njit(cache=True, inline="always")
@@ -367,27 +364,6 @@ def larger(a: float, b: float) -> float:
     """The larger of two stiffnesses, NaN if either is (Python's ``max`` keeps a NaN only as
     its first argument)."""
     return a if a >= b or a != a else b
-
-
-#: All bits of a float64 but its sign.
-_MAGNITUDE = (1 << 63) - 1
-
-
-def _bitcast(source: types.Type, target: types.Type) -> Callable[[Any], Any]:
-    """A compiled function that reads a value of one 64-bit type as another (no conversion)."""
-
-    def typer(typingctx: Any, value: Any) -> Any:
-        def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
-            return builder.bitcast(args[0], context.get_value_type(target))
-
-        return target(source), codegen
-
-    return cast(Callable[[Any], Any], intrinsic(typer))
-
-
-#: The bit pattern of a float64 as an int64, and back.
-_bits = _bitcast(types.float64, types.int64)
-_float = _bitcast(types.int64, types.float64)
 
 
 @numba.njit(cache=True, inline="always")
