@@ -501,14 +501,17 @@ def predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, 
 
 
 @uncounted()
-def _predict_not_inlined(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_,
-                         count, event, segments, piston):  # fmt: skip
-    """`predict` as a call rather than an inlined copy, for the passes over every slot (`rebuild`,
-    `_piston_moved`): each copy adds to LLVM's work at the first compilation, and saves nothing
-    there, where the prediction dwarfs the call. The event loop keeps its inlined copies: a
-    call there costs 7 to 10% of the collisions per second."""
-    return predict(k, now, crossed, body, ident, geometry, grid, cell_of, head, next_, count,
-                   event, segments, piston)  # fmt: skip
+def _predict_not_inlined(k, now, body, ident, geometry, grid, cell_of, head, next_, count, event,
+                         segments, piston):  # fmt: skip
+    """`predict` of slot k, which crossed no cell edge, as a call rather than an inlined copy,
+    for the passes over every slot (`rebuild`, `_piston_moved`): each copy adds to LLVM's work
+    at the first compilation, and saves nothing there, where the prediction dwarfs the call.
+    The event loop keeps its inlined copies: a call there costs 7 to 10% of the collisions per
+    second. The slot and the crossing are typed as the event loop's are (int32, and int64 not
+    the literal -1): numba compiles `predict` once for every other combination of types, a
+    second apiece at the first run."""
+    return predict(np.int32(k), now, np.int64(-1), body, ident, geometry, grid, cell_of, head,
+                   next_, count, event, segments, piston)  # fmt: skip
 
 
 # --- cells and slots ----------------------------------------------------------------------------
@@ -634,8 +637,8 @@ def rebuild(now, body, geometry, grid, head, next_, event, keys, items, segments
         items[k] = k
     sort_slots(body, cell_of, event, head, next_, items, where)
     for k in range(n):
-        keys[k] = _predict_not_inlined(k, now, -1, body, ident, geometry, grid, cell_of, head,
-                                       next_, count, event, segments, piston)  # fmt: skip
+        keys[k] = _predict_not_inlined(k, now, body, ident, geometry, grid, cell_of, head, next_,
+                                       count, event, segments, piston)  # fmt: skip
     _heap_build(keys, items, where)
 
 
@@ -759,7 +762,8 @@ def run_events(
                          midpoint, heat)  # fmt: skip
                 count[k] += 1
                 count[j] += 1
-                t_j = predict(j, t, -1, body, ident, geometry, grid, cell_of, head, next_,
+                # Not the literal -1, which numba would compile a second `predict` for.
+                t_j = predict(j, t, np.int64(-1), body, ident, geometry, grid, cell_of, head, next_,
                               count, event, segments, piston)  # fmt: skip
                 heap_update(j, t_j, keys, items, where)
         elif piston.shape[0] > 0 and code == FIRST_WALL_CODE - piston[pistons.WALL]:
@@ -813,8 +817,8 @@ def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count,
     code = FIRST_WALL_CODE - int(piston[pistons.WALL])
     for k in range(body.shape[0]):
         if event[k, CODE] == code:
-            t_k = _predict_not_inlined(k, now, -1, body, ident, geometry, grid, cell_of, head,
-                                       next_, count, event, segments, piston)  # fmt: skip
+            t_k = _predict_not_inlined(k, now, body, ident, geometry, grid, cell_of, head, next_,
+                                       count, event, segments, piston)  # fmt: skip
             heap_update(k, t_k, keys, items, where)
             continue
         x, y, vx, vy = _at(k, now, body, geometry)
