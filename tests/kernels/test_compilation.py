@@ -57,6 +57,21 @@ def _kernels() -> list[tuple[str, Any]]:
     return found
 
 
+def _callees(kernel: Any) -> list[Any]:
+    """The compiled kernels a kernel's code names: globals of its module, and attributes of the
+    modules it names (``events.run_events``)."""
+    scope = kernel.py_func.__globals__
+    names = kernel.py_func.__code__.co_names
+    named = [scope.get(word) for word in names]
+    named += [
+        vars(module).get(word)  # not getattr: NumPy 1.26 warns of its deprecated aliases
+        for module in named
+        if inspect.ismodule(module)
+        for word in names
+    ]
+    return [callee for callee in named if isinstance(callee, Dispatcher) and callee is not kernel]
+
+
 def test_no_compiled_kernel_calls_a_parallel_one():
     """A kernel that calls a parallel one breaks numba's cache: once the caller is compiled
     against a callee loaded from the cache, the next process that loads the caller crashes
@@ -65,15 +80,30 @@ def test_no_compiled_kernel_calls_a_parallel_one():
     kernels = _kernels()
     parallel = {id(k) for _, k in kernels if k.targetoptions.get("parallel")}
     assert parallel, "the kernels' parallel loops were not found"
-    offenders = []
-    for name, kernel in kernels:
-        scope = kernel.py_func.__globals__
-        called = [scope.get(word) for word in kernel.py_func.__code__.co_names]
-        called += [
-            vars(module).get(word)  # not getattr: NumPy 1.26 warns of its deprecated aliases
-            for module in called
-            if inspect.ismodule(module)
-            for word in kernel.py_func.__code__.co_names
-        ]
-        offenders += [name for callee in called if id(callee) in parallel and callee is not kernel]
+    offenders = [
+        name for name, kernel in kernels for callee in _callees(kernel) if id(callee) in parallel
+    ]
     assert offenders == []
+
+
+def test_what_a_kernel_without_reference_counting_calls_sets_its_own():
+    """numba compiles a kernel with its caller's reference counting unless the kernel sets its
+    own (`_nrt`). One that allocates, called first from a kernel compiled without counting
+    (`collidium.kernels.compilation.uncounted`), then fails to compile, but only on a fresh
+    cache and in that order: the compiled substeps' sweep (`sorting.sort_nearly_sorted`) did,
+    on a first run of `orbit`. So every kernel that such a kernel calls sets `_nrt` itself,
+    unless numba inlines it into its caller (``inline="always"``), whose callees then count as
+    the caller's."""
+    uncounted = [k for _, k in _kernels() if k.targetoptions.get("_nrt") is False]
+    assert uncounted, "the kernels without reference counting were not found"
+    offenders, seen, callers = set(), set(), list(uncounted)
+    while callers:
+        for callee in _callees(callers.pop()):
+            options = callee.targetoptions
+            if id(callee) in seen or options.get("_nrt") is not None:
+                continue
+            seen.add(id(callee))
+            callers.append(callee)  # its own callees inherit the caller's counting too
+            if options.get("inline") != "always":
+                offenders.add(f"{callee.py_func.__module__}.{callee.py_func.__qualname__}")
+    assert sorted(offenders) == []

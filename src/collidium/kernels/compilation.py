@@ -20,7 +20,11 @@ def uncounted(**options: Any) -> Any:
     """numba.njit, cached, for kernels that allocate nothing: compiled without numba's
     reference counting, which cannot prune the atomic counts it emits around array arguments
     when they span branches (numba issue #2350; with them the exact engine's prediction cost
-    five times as much, 150 against 30 ns at 1,000 disks)."""
+    five times as much, 150 against 30 ns at 1,000 disks).
+
+    A kernel that such a kernel calls must set its own counting (this, or ``_nrt=True`` where
+    it allocates): numba compiles it with its first caller's otherwise, and one that allocates
+    then fails to compile, on a fresh cache only (``tests/kernels/test_compilation.py``)."""
     return numba.njit(**{"cache": True, "_nrt": False, **options})
 
 

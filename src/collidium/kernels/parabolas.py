@@ -15,9 +15,7 @@ from __future__ import annotations
 
 import math
 
-import numba
-
-from collidium.kernels.compilation import inlined
+from collidium.kernels.compilation import inlined, uncounted
 
 #: Newton-bisection iterations at most for one root (bisection alone halves the bracket each
 #: time: 64 from any bracket of floats down to round-off, with margin).
@@ -80,7 +78,7 @@ def _state(px, py, vx, vy, gx, gy, t):
     return (px + (vx + 0.5 * gx * t) * t, py + (vy + 0.5 * gy * t) * t, vx + gx * t, vy + gy * t)
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _evaluate(kind, px, py, vx, vy, gx, gy, reach, sense, t):
     """``(value, slope)`` at time t of what `_solve` looks for the root of: for ``kind`` 0 the
     rate ``x . u`` at which the squared distance changes (half of it; its slope ``|u|^2 +
@@ -94,7 +92,7 @@ def _evaluate(kind, px, py, vx, vy, gx, gy, reach, sense, t):
     return sense * (size - reach), slope
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _solve(kind, px, py, vx, vy, gx, gy, reach, sense, lo, hi, rising):
     """The root in ``[lo, hi]`` of `_evaluate`'s function, which is monotone there, rising
     (``rising``) or falling through 0 between the ends: Newton's iteration kept inside the
@@ -119,7 +117,7 @@ def _solve(kind, px, py, vx, vy, gx, gy, reach, sense, lo, hi, rising):
     return t
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _crossing_in(px, py, vx, vy, gx, gy, reach, sense, lo, hi) -> float:
     """The crossing on ``[lo, hi]``, an interval on which the distance is monotone (`
     distance_crossing`): its time, ``lo`` if the body is already across there and moving on
@@ -135,7 +133,7 @@ def _crossing_in(px, py, vx, vy, gx, gy, reach, sense, lo, hi) -> float:
     return _solve(1, px, py, vx, vy, gx, gy, reach, sense, lo, hi, True)
 
 
-@numba.njit(cache=True)
+@uncounted()
 def distance_crossing(px, py, vx, vy, gx, gy, reach, outward, horizon) -> float:
     """The first time t in ``[0, horizon]`` at which a body at (px, py) moving at (vx, vy) under
     the acceleration (gx, gy), not both 0, crosses the distance ``reach`` (m) from the origin

@@ -43,7 +43,7 @@ RECORD = ("kinetic", "potential", "virial", "px", "py", "total_speed")
 CONTACT_MARGIN = 1e-6
 
 
-@numba.njit(cache=True)
+@uncounted()
 def energy_scale(kinetic: float, total: float, floor: float) -> float:
     """The energy (J) the substep rate judges the energy error against: ``|E|``, but at least
     ``(KE + |U|) / floor``, with the potential ``U = E - KE`` (``total`` E and ``kinetic`` KE in

@@ -15,7 +15,7 @@ import numba
 import numpy as np
 
 from collidium.kernels import parabolas
-from collidium.kernels.compilation import inlined
+from collidium.kernels.compilation import inlined, uncounted
 
 
 @inlined
@@ -58,7 +58,7 @@ def wall_delay(
     return best, wall
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _falling_wall_delay(x, y, vx, vy, r, half_width, half_height, gx, gy) -> tuple[float, int]:
     """`wall_delay` on a parabola: each wall's gap closes on a quadratic. A call, not inlined:
     the engine inlines `wall_delay`, and this arithmetic would only add to its compile time."""

@@ -17,11 +17,10 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from collidium.kernels import wall_responses
-from collidium.kernels.compilation import inlined
+from collidium.kernels.compilation import inlined, uncounted
 from collidium.kernels.parabolas import first_contact
 from collidium.kernels.vessels import box
 
@@ -68,7 +67,7 @@ def delay(piston, now, x, y, vx, vy, r, gx=0.0, gy=0.0) -> float:
     return first_contact(height - s - r, speed - v, piston[PULL] - g)
 
 
-@numba.njit(cache=True)
+@uncounted()
 def earliest(x, y, vx, vy, r, half_width, half_height, piston, now, gx=0.0, gy=0.0
              ) -> tuple[float, int]:  # fmt: skip
     """`collidium.kernels.vessels.box.wall_delay` for a box one of whose walls is the piston:
@@ -95,7 +94,7 @@ def earliest(x, y, vx, vy, r, half_width, half_height, piston, now, gx=0.0, gy=0
     return best, wall
 
 
-@numba.njit(cache=True)
+@uncounted()
 def touch(piston, t, x, y, r) -> tuple[float, float, float, float]:
     """A disk of radius r at (x, y) touching the piston at time t: ``(x, y, nx, ny)``, its
     centre snapped onto the contact line (so round-off never leaves it past the face) and the
@@ -108,7 +107,7 @@ def touch(piston, t, x, y, r) -> tuple[float, float, float, float]:
     return x, touching, 0.0, sign
 
 
-@numba.njit(cache=True)
+@uncounted()
 def hit(piston, t, vx, vy, mass, elastic_below) -> tuple[float, float, float, float]:
     """A disk of ``mass`` kg moving at (vx, vy) m/s hits the piston at time t (s): the piston's
     state is brought to t and its speed changed (`wall_responses.moving_wall`). A hit slower
@@ -135,7 +134,7 @@ def hit(piston, t, vx, vy, mass, elastic_below) -> tuple[float, float, float, fl
     return vx, vy, mass * (outward - after), work
 
 
-@numba.njit(cache=True)
+@uncounted()
 def schedule(piston: np.ndarray) -> None:
     """Set the time at which the piston next reaches an end of its travel (NEXT, s; inf if
     never on its present path)."""
@@ -145,7 +144,7 @@ def schedule(piston: np.ndarray) -> None:
     piston[NEXT] = piston[STAMP] + min(out, back)
 
 
-@numba.njit(cache=True)
+@uncounted()
 def arrive(piston: np.ndarray) -> None:
     """The piston reaches an end of its travel at time NEXT: a driven one stops there, a free
     one bounces back elastically from the guides' end."""

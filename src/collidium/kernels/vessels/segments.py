@@ -16,10 +16,8 @@ from __future__ import annotations
 
 import math
 
-import numba
-
 from collidium.kernels import parabolas
-from collidium.kernels.compilation import inlined
+from collidium.kernels.compilation import inlined, uncounted
 
 #: Columns of a segment table.
 X0, Y0, X1, Y1, TX, TY, LENGTH, WALL, BOUNDARY = range(9)
@@ -85,7 +83,7 @@ def element_delay(
     return delay
 
 
-@numba.njit(cache=True)
+@uncounted()
 def _flat_delay_on_parabola(px, py, vx, vy, gx, gy, r, tx, ty, length) -> float:
     """`element_delay` of a flat part for a disk on a parabola, from (px, py) off the segment's
     start: the first time its distance to the line, a quadratic in t, comes to r on the disk's
