@@ -208,6 +208,56 @@ def _tile(first, second, size, x, y, q, coupling, softening2, width, height, per
         sums[3, i] += w
 
 
+#: Particles with a source up to which the pair sums take a plain loop (`_few`) instead of the
+#: tiles: a two-body substep spent a fifth of its time in the tiles' calls and vector set-up.
+FEW = 8
+
+
+@uncounted(forceinline=True, fastmath={"contract"}, error_model="numpy")
+def _few(x, y, q, coupling, softening2, width, height, periodic, sums) -> None:
+    """The pair sums of a few particles into ``sums`` (4, m), zeroed first: each pair once, in
+    `_tile`'s order, one pair at a time (no reassociation: LLVM makes no vectors of so short a
+    loop)."""
+    _zero(sums)
+    m = x.shape[0]
+    for i in range(m):
+        xi, yi, kqi = x[i], y[i], coupling * q[i]
+        fx = 0.0
+        fy = 0.0
+        u = 0.0
+        w = 0.0
+        for j in range(i + 1, m):
+            dx = xi - x[j]
+            dy = yi - y[j]
+            if periodic:
+                dx -= width * round(dx / width)
+                dy -= height * round(dy / height)
+            r2 = dx * dx + dy * dy
+            f, uij = inverse_distance_pair(r2, kqi * q[j], softening2)
+            fx += f * dx
+            fy += f * dy
+            u += uij
+            w += f * r2
+            sums[0, j] -= f * dx
+            sums[1, j] -= f * dy
+            sums[2, j] += uij
+            sums[3, j] += f * r2
+        sums[0, i] += fx
+        sums[1, i] += fy
+        sums[2, i] += u
+        sums[3, i] += w
+
+
+@uncounted(forceinline=True)
+def _one_task(blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums):
+    """The pair sums when they make one task, into ``sums`` itself: `_few` for up to `FEW`
+    particles, else the task's tiles (`_task`)."""
+    if x.shape[0] <= FEW:
+        _few(x, y, q, coupling, softening2, width, height, periodic, sums)
+    else:
+        _task(0, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
+
+
 @uncounted()
 def _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums) -> None:
     """Task t of the pair sums: the tiles of block rows t and ``blocks - 1 - t`` (each tile of a
@@ -239,7 +289,7 @@ def _zero(sums) -> None:
             sums[d, c] = 0.0
 
 
-@uncounted()
+@uncounted(forceinline=True)  # into the substeps' loop: a call there cost a fifth
 def pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buffer) -> None:
     """Every pair's force x, y, energy and ``r . F`` on both particles into ``sums`` (4, m),
     each pair once, on the calling thread: task by task, each in a buffer of its own, the
@@ -261,7 +311,7 @@ def pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buff
     m = x.shape[0]
     size, blocks, tasks = _blocks(m)
     if tasks == 1:  # as `direct_parallel` does
-        _task(0, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
+        _one_task(blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
         return
     buffers = buffer[: tasks * 4 * m].reshape((tasks, 4, m))
     for t in range(tasks):
@@ -294,7 +344,7 @@ def direct_parallel(position, source, coupling, softening2, width, height, perio
     size, blocks, tasks = _blocks(m)
     sums = np.empty((4, m))
     if tasks == 1:  # one task sums into ``sums`` itself, as in `pair_sums`
-        _task(0, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
+        _one_task(blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
     else:
         buffers = np.empty((tasks, 4, m))
         for t in numba.prange(tasks):
