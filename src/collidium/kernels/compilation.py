@@ -22,10 +22,17 @@ def uncounted(**options: Any) -> Any:
     when they span branches (numba issue #2350; with them the exact engine's prediction cost
     five times as much, 150 against 30 ns at 1,000 disks).
 
-    A kernel that such a kernel calls must set its own counting (this, or ``_nrt=True`` where
-    it allocates): numba compiles it with its first caller's otherwise, and one that allocates
+    A kernel that such a kernel calls must set its own counting (this, or `counted` where it
+    allocates): numba compiles it with its first caller's otherwise, and one that allocates
     then fails to compile, on a fresh cache only (``tests/kernels/test_compilation.py``)."""
     return numba.njit(**{"cache": True, "_nrt": False, **options})
+
+
+def counted(**options: Any) -> Any:
+    """numba.njit, cached, with numba's reference counting on by choice, for a kernel that
+    allocates and that kernels compiled without counting (`uncounted`) call: numba would
+    otherwise compile it with its first caller's, and fail."""
+    return numba.njit(**{"cache": True, "_nrt": True, **options})
 
 
 #: For the helpers of such kernels: LLVM inlines them into their callers (numba's

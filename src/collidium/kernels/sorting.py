@@ -12,6 +12,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from collidium.kernels.compilation import counted
+
 #: Unsigned indices: no wraparound of negative ones.
 _u = numba.uint64
 
@@ -71,10 +73,7 @@ def radix_sort(
             values[:] = values_spare
 
 
-# With reference counting always: its merge sort allocates, and numba would otherwise compile it
-# without when a kernel compiled without (`collidium.kernels.compilation.uncounted`) calls it
-# first, and fail there.
-@numba.njit(cache=True, _nrt=True)
+@counted()  # its merge sort allocates, and the compiled substeps call it
 def sort_nearly_sorted(index: np.ndarray, key: np.ndarray) -> None:
     """Stable sort of ``index`` (M,) in place by ``key[index]``, for a list that is nearly in
     order already: an insertion sort has little to do; past a budget of shifts a merge sort takes
