@@ -166,10 +166,10 @@ def _blocks(m: int) -> tuple[int, int, int]:
     return size, blocks, (blocks + 1) // 2
 
 
-@uncounted(fastmath=_FASTMATH, error_model="numpy")
-def _tile(first, second, size, x, y, q, coupling, softening2, width, height, periodic, sums):
-    """The pairs of block ``first`` with block ``second`` (each pair of the block once when they
-    are the same), added to both particles' ``sums`` (4, m): force x, y, pair energy, ``r . F``.
+@numba.njit(cache=True, inline="always")  # compiled with each caller's flags
+def _row(i, lo, hi, x, y, q, coupling, softening2, width, height, periodic, sums) -> None:
+    """The pairs of particle i with particles ``lo`` to ``hi - 1``, added to both particles'
+    ``sums`` (4, m): force x, y, pair energy, ``r . F``; i's own in four running sums first.
 
     The energies are summed whether or not they are wanted: a loop without their sums on the j
     side was a fifth faster, but the forces are then bitwise the same as this loop's only as
@@ -178,34 +178,42 @@ def _tile(first, second, size, x, y, q, coupling, softening2, width, height, per
 
     The pair loops count with unsigned integers: a signed j could be negative, which numba
     wraps around, and LLVM would then gather the loads, four times slower."""
+    xi, yi, kqi = x[i], y[i], coupling * q[i]
+    fx = 0.0
+    fy = 0.0
+    u = 0.0
+    w = 0.0
+    for j in range(_u(lo), _u(hi)):
+        dx = xi - x[j]
+        dy = yi - y[j]
+        if periodic:  # the same every pass: LLVM takes it out of the loop
+            dx -= width * round(dx / width)
+            dy -= height * round(dy / height)
+        r2 = dx * dx + dy * dy
+        f, uij = inverse_distance_pair(r2, kqi * q[j], softening2)
+        fx += f * dx
+        fy += f * dy
+        u += uij
+        w += f * r2
+        sums[0, j] -= f * dx
+        sums[1, j] -= f * dy
+        sums[2, j] += uij
+        sums[3, j] += f * r2
+    sums[0, i] += fx
+    sums[1, i] += fy
+    sums[2, i] += u
+    sums[3, i] += w
+
+
+@uncounted(fastmath=_FASTMATH, error_model="numpy")
+def _tile(first, second, size, x, y, q, coupling, softening2, width, height, periodic, sums):
+    """The pairs of block ``first`` with block ``second`` (each pair of the block once when they
+    are the same), added to both particles' ``sums`` (4, m) (`_row`); vectorised, the running
+    sums in several lanes."""
     m = x.shape[0]
     for i in range(first * size, min(m, (first + 1) * size)):
         lo, hi = max(second * size, i + 1), min(m, (second + 1) * size)
-        xi, yi, kqi = x[i], y[i], coupling * q[i]
-        fx = 0.0
-        fy = 0.0
-        u = 0.0
-        w = 0.0
-        for j in range(_u(lo), _u(hi)):
-            dx = xi - x[j]
-            dy = yi - y[j]
-            if periodic:  # the same every pass: LLVM takes it out of the loop
-                dx -= width * round(dx / width)
-                dy -= height * round(dy / height)
-            r2 = dx * dx + dy * dy
-            f, uij = inverse_distance_pair(r2, kqi * q[j], softening2)
-            fx += f * dx
-            fy += f * dy
-            u += uij
-            w += f * r2
-            sums[0, j] -= f * dx
-            sums[1, j] -= f * dy
-            sums[2, j] += uij
-            sums[3, j] += f * r2
-        sums[0, i] += fx
-        sums[1, i] += fy
-        sums[2, i] += u
-        sums[3, i] += w
+        _row(i, lo, hi, x, y, q, coupling, softening2, width, height, periodic, sums)
 
 
 #: Particles with a source up to which the pair sums take a plain loop (`_few`) instead of the
@@ -216,36 +224,12 @@ FEW = 8
 @uncounted(forceinline=True, fastmath={"contract"}, error_model="numpy")
 def _few(x, y, q, coupling, softening2, width, height, periodic, sums) -> None:
     """The pair sums of a few particles into ``sums`` (4, m), zeroed first: each pair once, in
-    `_tile`'s order, one pair at a time (no reassociation: LLVM makes no vectors of so short a
-    loop)."""
+    `_tile`'s order (`_row`), one pair at a time (no reassociation: LLVM makes no vectors of so
+    short a loop)."""
     _zero(sums)
     m = x.shape[0]
     for i in range(m):
-        xi, yi, kqi = x[i], y[i], coupling * q[i]
-        fx = 0.0
-        fy = 0.0
-        u = 0.0
-        w = 0.0
-        for j in range(i + 1, m):
-            dx = xi - x[j]
-            dy = yi - y[j]
-            if periodic:
-                dx -= width * round(dx / width)
-                dy -= height * round(dy / height)
-            r2 = dx * dx + dy * dy
-            f, uij = inverse_distance_pair(r2, kqi * q[j], softening2)
-            fx += f * dx
-            fy += f * dy
-            u += uij
-            w += f * r2
-            sums[0, j] -= f * dx
-            sums[1, j] -= f * dy
-            sums[2, j] += uij
-            sums[3, j] += f * r2
-        sums[0, i] += fx
-        sums[1, i] += fy
-        sums[2, i] += u
-        sums[3, i] += w
+        _row(i, i + 1, m, x, y, q, coupling, softening2, width, height, periodic, sums)
 
 
 @uncounted(forceinline=True)
