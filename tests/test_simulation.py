@@ -362,14 +362,17 @@ class StateReader:
 
 @pytest.mark.parametrize(
     ("name", "time"),
-    [("orbit", 3.0), ("bohr-atom", 1.0), ("charged-opposite", 8.0), ("charged-gas", 0.1)],
-)
+    [("orbit", 3.0), ("bohr-atom", 1.0), ("charged-opposite", 8.0), ("charged-gas", 0.1),
+     ("spectrometer", 10.0), ("projectile", 5.0)],
+)  # fmt: skip
 def test_steps_flown_in_one_call_are_bitwise_those_taken_one_by_one(name, time):
     """A small charged scene flies the steps between the observers that read its state in one
     compiled call: the run ends bit for bit as one whose observer reads every step, and the
     observers that take what a flight records (energy drift every step and every seventh, the
     energy series, the thermodynamics and the collision counts every third) measure bit for bit
-    the same. charged-opposite collides, the charged gas meets a contact in most substeps."""
+    the same. charged-opposite collides, the charged gas meets a contact in most substeps; the
+    spectrometer's ions turn in a magnetic field and land on the floor, the projectile falls
+    in a uniform field (its potential energy in the record) and bounces."""
     runs = []
     for reader in (StateReader(Every(250)), StateReader(Every(1))):
         sim = cd.load(name)

@@ -31,6 +31,7 @@ import numpy as np
 from collidium.collisions import Contact, Drift, FlightRecord, Tally
 from collidium.errors import SimulationError
 from collidium.forces import ForceField
+from collidium.forces.base import CompiledForces
 from collidium.kernels import substeps, sums
 from collidium.kernels.pairwise import PARALLEL_DIRECT_FROM
 from collidium.state import FloatArray, Particles
@@ -588,50 +589,59 @@ def _newton(
 @dataclass(frozen=True, eq=False)
 class _SmoothFlight:
     """A scene's part in the compiled contact-free substeps (`collidium.kernels.substeps`): the
-    vessel and forces it was made for, copies of the masses, radii and the pair force's sources
-    (the particles' property ``name``), its coupling and squared softening, and the walls as the
-    exact engine has them. The integrator keeps it while it `fits`: making it is most of the
-    Python work of a small scene's reporting interval."""
+    vessel and forces it was made for, copies of the masses, radii and charges, the forces as
+    the substeps take them (`ForceField.compiled`: the pair force's sources, coupling and
+    squared softening, a uniform field's forces, a magnetic field's frequencies and region), and
+    the walls as the exact engine has them. The integrator keeps it while it `fits`: making it
+    is most of the Python work of a small scene's reporting interval."""
 
     vessel: Vessel
     field: ForceField
-    name: str
+    forces: CompiledForces
     mass: FloatArray
     radius: FloatArray
+    charge: FloatArray
     source: FloatArray
-    coupling: float
-    softening2: float
     walls: tuple[int, float, float, float, FloatArray]
 
     @classmethod
     def of(cls, particles: Particles, vessel: Vessel, field: ForceField) -> _SmoothFlight | None:
         """The scene's part, or None unless the vessel has walls (not periodic), the particles
-        are few enough for one thread (`PARALLEL_DIRECT_FROM`) and the one force is a direct
-        pair sum (`ForceField.direct_term`; a vessel with a piston has no such force). A
-        substep that meets no contact is a straight flight in every collision mode."""
+        are few enough for one thread (`PARALLEL_DIRECT_FROM`) and the forces are those the
+        substeps take (`ForceField.compiled`; a vessel with a piston has no pair sum of
+        theirs). A substep that meets no contact is a straight flight in every collision
+        mode."""
         if vessel.periodic or particles.n >= PARALLEL_DIRECT_FROM:
             return None
-        term = field.direct_term(particles, vessel)
-        if term is None:
+        forces = field.compiled(particles, vessel)
+        if forces is None:
             return None
-        name, coupling, softening2 = term
         half_width, half_height = (0.5 * float(side) for side in vessel.extent)
         walls = (vessel.shape_code, half_width, half_height, vessel.rim, vessel.segments())
+        name = forces.source
+        source = np.zeros(particles.n) if name is None else getattr(particles, name)
         # Contiguous copies: the particles' arrays may be edited in place (`fits` compares), and
         # a shared value is a stride-0 view, which would compile the substeps again.
-        return cls(vessel, field, name, np.array(particles.mass), np.array(particles.radius),
-                   np.array(getattr(particles, name)), coupling, softening2, walls)  # fmt: skip
+        return cls(vessel, field, forces, np.array(particles.mass), np.array(particles.radius),
+                   np.array(particles.charge), np.array(source), walls)  # fmt: skip
 
     def fits(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
         """Whether this is still the scene's part: the same vessel and forces, and particles of
-        the same masses, radii and sources."""
+        the same masses, radii and charges (the uniform field, the magnetic field and the pair
+        force's sources are of those)."""
         return (
             vessel is self.vessel
             and field is self.field
             and np.array_equal(particles.mass, self.mass)
             and np.array_equal(particles.radius, self.radius)
-            and np.array_equal(getattr(particles, self.name), self.source)
+            and np.array_equal(particles.charge, self.charge)
         )
+
+    @property
+    def _forces(self) -> tuple[FloatArray, float, float, FloatArray, FloatArray, FloatArray]:
+        """The forces' arguments of the compiled substeps."""
+        f = self.forces
+        return self.source, f.coupling, f.softening2, f.uniform, f.turn, f.region
 
     def intervals(
         self,
@@ -650,7 +660,7 @@ class _SmoothFlight:
         is kept current."""
         flown, after = substeps.smooth_intervals(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
-            self.source, self.coupling, self.softening2, *self.walls, origin, elapsed, dt,
+            *self._forces, *self.walls, origin, elapsed, dt,
             record.shape[0], starting, tolerance, MAX_SUBSTEPS, TOTAL_ENERGY_FLOOR, record,
         )  # fmt: skip
         return int(flown), int(after)
@@ -678,7 +688,7 @@ class _SmoothFlight:
         is kept current; its energies are summed again when read."""
         return substeps.smooth_substeps(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
-            self.source, self.coupling, self.softening2, *self.walls, now, dt, first, count, t,
+            *self._forces, *self.walls, now, dt, first, count, t,
             fastest, total, TOTAL_ENERGY_FLOOR,
         )  # fmt: skip
 

@@ -21,6 +21,8 @@ from collidium.kernels.vessels import BOX, CIRCLE, POLYGON
 
 FLOOR = 10.0
 NONE = np.empty((0, 9))
+#: No uniform field and no magnetic field (`smooth_substeps`'s ``uniform, turn, region``).
+FREE = (np.empty((0, 2)), np.empty(0), np.array([-np.inf, -np.inf, np.inf, np.inf]))
 HEXAGON = Polygon([[6.0 * np.cos(a), 6.0 * np.sin(a)] for a in np.arange(6) * np.pi / 3])
 
 
@@ -65,18 +67,76 @@ def test_substeps_equal_their_twin(rng, vessel, speed):
     total = kinetic_energy(mass, velocity) + energy(position, source, coupling, softening2)
     got = [a.copy() for a in (position, velocity, acceleration)]
     want = [a.copy() for a in (position, velocity, acceleration)]
-    step, t, fastest = smooth_substeps(*got, mass, radius, source, coupling, softening2, shape,
-                                       half[0], half[1], rim, table, 1.0, 0.1, 1, 16, 1.0, 0.0,
-                                       total, FLOOR)  # fmt: skip
-    twin = reference.smooth_substeps(*want, mass, radius, source, coupling, softening2, shape,
-                                     half, rim, table, 1.0, 0.1, 1, 16, 1.0, 0.0, total, FLOOR,
-                                     CONTACT_MARGIN)  # fmt: skip
+    step, t, fastest = smooth_substeps(*got, mass, radius, source, coupling, softening2, *FREE,
+                                       shape, half[0], half[1], rim, table, 1.0, 0.1, 1, 16, 1.0,
+                                       0.0, total, FLOOR)  # fmt: skip
+    twin = reference.smooth_substeps(*want, mass, radius, source, coupling, softening2, *FREE,
+                                     shape, half, rim, table, 1.0, 0.1, 1, 16, 1.0, 0.0, total,
+                                     FLOOR, CONTACT_MARGIN)  # fmt: skip
     assert (step, t) == twin[:2]
     assert (step == 17) == (speed < 1.0)
     assert step > 1 or speed > 1.0  # the fast disks too take some substeps first
     np.testing.assert_allclose(fastest, twin[2], rtol=1e-12)
     for ours, theirs in zip(got, want, strict=True):
         np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-12)
+
+
+def fields(position, mass, charge):
+    """A uniform field E = (0.3, -0.8) N/C and a magnetic field of 2 T in the left half of a
+    box (x < 0): the fields' forces, cyclotron frequencies and region."""
+    uniform = charge[:, None] * np.array([0.3, -0.8])
+    return uniform, 2.0 * charge / mass, np.array([-np.inf, -np.inf, 0.0, np.inf])
+
+
+@pytest.mark.parametrize("pair", [True, False])
+def test_substeps_under_uniform_and_magnetic_fields_equal_their_twin(rng, pair):
+    """Charges with (or without) their Coulomb pairs under a uniform electric field and a
+    magnetic field over half the box: the same substeps as the twin's, the motion and the rate
+    (the cyclotron frequency's square where it is the larger) to round-off; the turn keeps each
+    speed where it alone acts."""
+    position, velocity, mass, radius, charge, coupling, softening2 = scene(rng, 12, speed=2.0)
+    uniform, turn, region = fields(position, mass, charge)
+    source = charge if pair else np.zeros_like(charge)
+    acceleration = (accelerations(position, mass, source, coupling, softening2)
+                    + uniform / mass[:, None])  # fmt: skip
+    total = kinetic_energy(mass, velocity) + energy(position, source, coupling, softening2)
+    total -= float(np.sum(position * uniform))
+    got = [a.copy() for a in (position, velocity, acceleration)]
+    want = [a.copy() for a in (position, velocity, acceleration)]
+    shape, half, rim, table = WALLS["box"]
+    step, t, fastest = smooth_substeps(*got, mass, radius, source, coupling, softening2, uniform,
+                                       turn, region, shape, half[0], half[1], rim, table, 1.0,
+                                       0.5, 1, 32, 1.0, 0.0, total, FLOOR)  # fmt: skip
+    twin = reference.smooth_substeps(*want, mass, radius, source, coupling, softening2, uniform,
+                                     turn, region, shape, half, rim, table, 1.0, 0.5, 1, 32, 1.0,
+                                     0.0, total, FLOOR, CONTACT_MARGIN)  # fmt: skip
+    assert (step, t) == twin[:2]
+    assert step > 4  # some substeps taken before a contact, if any
+    np.testing.assert_allclose(fastest, twin[2], rtol=1e-12)
+    if not pair:
+        assert fastest == np.max(np.abs(turn)) ** 2
+    for ours, theirs in zip(got, want, strict=True):
+        np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-12)
+
+
+def test_a_magnetic_field_turns_a_charge_without_changing_its_speed():
+    """A free charge in a field filling the plane circles at its cyclotron frequency: after
+    substeps making half a period it has turned its velocity round, to O((omega h)^2), with
+    its speed kept to round-off."""
+    position = np.array([[0.0, -1.0]])
+    velocity = np.array([[1.0, 0.0]])
+    mass = np.ones(1)
+    whole = np.array([-np.inf, -np.inf, np.inf, np.inf])
+    omega = 1.0  # q B / m: clockwise, on the circle of radius 1 about (0, -2)
+    args = (np.zeros((1, 2)), mass, np.full(1, 0.1), np.zeros(1), 0.0, 0.0, np.empty((0, 2)),
+            np.full(1, omega), whole, BOX, 5.0, 5.0, np.nan, NONE, 0.0, np.pi, 1, 256, 0.0,
+            0.0, 0.5, FLOOR)  # fmt: skip
+    step, t, fastest = smooth_substeps(position, velocity, *args)
+    assert (step, fastest) == (257, omega**2)
+    assert t == pytest.approx(np.pi, rel=1e-15)
+    np.testing.assert_allclose(velocity[0], [-1.0, 0.0], atol=(np.pi / 256) ** 2)
+    assert np.hypot(*velocity[0]) == pytest.approx(1.0, rel=1e-14)
+    np.testing.assert_allclose(position[0], [0.0, -3.0], atol=(np.pi / 256) ** 2)
 
 
 def test_a_crowd_stops_where_its_all_pairs_twin_stops(rng):
@@ -91,7 +151,7 @@ def test_a_crowd_stops_where_its_all_pairs_twin_stops(rng):
         position = grid + rng.uniform(-0.2, 0.2, grid.shape)  # gaps of 0.1 m at least
         radius = rng.uniform(0.05, 0.3, n)
         velocity = rng.normal(0.0, 1.0, (n, 2))
-        args = (np.zeros((n, 2)), np.ones(n), radius, np.zeros(n), 5.0, 0.0, BOX)
+        args = (np.zeros((n, 2)), np.ones(n), radius, np.zeros(n), 5.0, 0.0, *FREE, BOX)
         got, want = (position.copy(), velocity.copy()), (position.copy(), velocity.copy())
         step, t, _ = smooth_substeps(*got, *args, 20.0, 20.0, np.nan, NONE, 0.0, 2.0, 1, 64, 0.0,
                                      0.0, 1.0, FLOOR)  # fmt: skip
@@ -113,8 +173,8 @@ def test_a_disk_bound_for_a_wall_stops_the_substeps_just_before_it():
     acceleration = np.zeros((2, 2))
     mass, radius = np.ones(2), np.array([0.1, 0.1])
     step, t, _ = smooth_substeps(position, velocity, acceleration, mass, radius, np.zeros(2), 5.0,
-                                 0.0, BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.16, 1, 16, 0.0, 0.0,
-                                 50.0, FLOOR)  # fmt: skip
+                                 0.0, *FREE, BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.16, 1, 16, 0.0,
+                                 0.0, 50.0, FLOOR)  # fmt: skip
     # The wall's contact is at x = 4.9, 0.1 s on: substeps 1 to 9 end at 0.09 s.
     assert (step, t) == (10, pytest.approx(0.09, rel=1e-15))
     np.testing.assert_allclose(position[0], [3.9 + 0.9, 0.0], rtol=1e-14)
@@ -128,8 +188,8 @@ def test_a_grazing_pair_stops_the_substeps_within_the_margin(miss):
     sigma = 0.2
     position = np.array([[-1.0, 0.5 * sigma * (1 + miss)], [1.0, -0.5 * sigma * (1 + miss)]])
     velocity = np.array([[5.0, 0.0], [-5.0, 0.0]])
-    args = (np.zeros((2, 2)), np.ones(2), np.full(2, 0.5 * sigma), np.zeros(2), 5.0, 0.0, BOX,
-            5.0, 5.0, np.nan, NONE, 0.0, 0.4, 1, 4, 0.0, 0.0, 25.0, FLOOR)  # fmt: skip
+    args = (np.zeros((2, 2)), np.ones(2), np.full(2, 0.5 * sigma), np.zeros(2), 5.0, 0.0, *FREE,
+            BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.4, 1, 4, 0.0, 0.0, 25.0, FLOOR)  # fmt: skip
     step, _, _ = smooth_substeps(position, velocity, *args)
     assert step == (5 if miss > CONTACT_MARGIN else 2)  # they meet in the second 0.1 s
 
@@ -142,8 +202,9 @@ def test_infinite_accelerations_stop_the_substeps_with_nothing_changed():
     acceleration = np.zeros((2, 2))
     before = position.copy()
     step, t, fastest = smooth_substeps(position, velocity, acceleration, np.array([1e-310, 1.0]),
-                                       np.zeros(2), np.ones(2), 5.0, 0.0, BOX, 5.0, 5.0, np.nan,
-                                       NONE, 0.0, 0.1, 1, 4, 0.0, 0.0, 2.5, FLOOR)  # fmt: skip
+                                       np.zeros(2), np.ones(2), 5.0, 0.0, *FREE, BOX, 5.0, 5.0,
+                                       np.nan, NONE, 0.0, 0.1, 1, 4, 0.0, 0.0, 2.5,
+                                       FLOOR)  # fmt: skip
     assert (step, t, fastest) == (1, 0.0, 0.0)
     np.testing.assert_array_equal(position, before)
     np.testing.assert_array_equal(velocity, 0.0)
@@ -180,15 +241,37 @@ def test_intervals_equal_their_twin(count):
     got = [a.copy() for a in (position, velocity, acceleration)]
     want = [a.copy() for a in (position, velocity, acceleration)]
     record = np.empty((count, len(RECORD)))
-    flown, after = smooth_intervals(*got, mass, radius, charge, 5.0, 0.0, BOX, 5.0, 5.0, np.nan,
-                                    NONE, 0.0, 0, 0.05, count, 1, TOLERANCE, MOST, FLOOR,
+    flown, after = smooth_intervals(*got, mass, radius, charge, 5.0, 0.0, *FREE, BOX, 5.0, 5.0,
+                                    np.nan, NONE, 0.0, 0, 0.05, count, 1, TOLERANCE, MOST, FLOOR,
                                     record)  # fmt: skip
-    twin = reference.smooth_intervals(*want, mass, radius, charge, 5.0, 0.0, BOX,
+    twin = reference.smooth_intervals(*want, mass, radius, charge, 5.0, 0.0, *FREE, BOX,
                                       np.array([5.0, 5.0]), np.nan, NONE, 0.0, 0, 0.05, count, 1,
                                       TOLERANCE, MOST, FLOOR, CONTACT_MARGIN)  # fmt: skip
     assert (flown, after) == (count, twin[1]) and twin[0] == count
     assert after >= 8  # the inner orbit needs substeps
     np.testing.assert_allclose(record, twin[2], rtol=1e-11, atol=1e-12)
+    for ours, theirs in zip(got, want, strict=True):
+        np.testing.assert_allclose(ours, theirs, rtol=1e-10, atol=1e-12)
+
+
+def test_intervals_under_fields_equal_their_twin():
+    """The three bodies under a uniform electric field and a magnetic field over half the box:
+    the record's potential has the field's ``-F . x`` too, as the twin's."""
+    position, velocity, mass, radius, charge = three_bodies()
+    uniform, turn, region = fields(position, mass, charge)
+    acceleration = accelerations(position, mass, charge, 5.0, 0.0) + uniform / mass[:, None]
+    got = [a.copy() for a in (position, velocity, acceleration)]
+    want = [a.copy() for a in (position, velocity, acceleration)]
+    record = np.empty((20, len(RECORD)))
+    flown, after = smooth_intervals(*got, mass, radius, charge, 5.0, 0.0, uniform, turn, region,
+                                    BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0, 0.05, 20, 1, TOLERANCE,
+                                    MOST, FLOOR, record)  # fmt: skip
+    twin = reference.smooth_intervals(*want, mass, radius, charge, 5.0, 0.0, uniform, turn,
+                                      region, BOX, np.array([5.0, 5.0]), np.nan, NONE, 0.0, 0,
+                                      0.05, 20, 1, TOLERANCE, MOST, FLOOR,
+                                      CONTACT_MARGIN)  # fmt: skip
+    assert (flown, after) == twin[:2] and flown >= 10
+    np.testing.assert_allclose(record[:flown], twin[2], rtol=1e-11, atol=1e-12)
     for ours, theirs in zip(got, want, strict=True):
         np.testing.assert_allclose(ours, theirs, rtol=1e-10, atol=1e-12)
 
@@ -202,13 +285,13 @@ def test_an_interval_that_meets_a_wall_is_left_as_it_began():
     acceleration = accelerations(position, mass, charge, 5.0, 0.0)
     state = [a.copy() for a in (position, velocity, acceleration)]
     record = np.empty((10, len(RECORD)))
-    flown, after = smooth_intervals(*state, mass, radius, charge, 5.0, 0.0, BOX, 5.0, 5.0, np.nan,
-                                    NONE, 0.0, 0, 0.05, 10, 1, TOLERANCE, MOST, FLOOR,
-                                    record)  # fmt: skip
+    flown, after = smooth_intervals(*state, mass, radius, charge, 5.0, 0.0, *FREE, BOX, 5.0,
+                                    5.0, np.nan, NONE, 0.0, 0, 0.05, 10, 1, TOLERANCE, MOST,
+                                    FLOOR, record)  # fmt: skip
     assert 1 <= flown <= 3
     before = [a.copy() for a in (position, velocity, acceleration)]
-    _, want = smooth_intervals(*before, mass, radius, charge, 5.0, 0.0, BOX, 5.0, 5.0, np.nan,
-                               NONE, 0.0, 0, 0.05, flown, 1, TOLERANCE, MOST, FLOOR,
+    _, want = smooth_intervals(*before, mass, radius, charge, 5.0, 0.0, *FREE, BOX, 5.0, 5.0,
+                               np.nan, NONE, 0.0, 0, 0.05, flown, 1, TOLERANCE, MOST, FLOOR,
                                record)  # fmt: skip
     assert after == want
     for ours, theirs in zip(state, before, strict=True):
@@ -221,8 +304,8 @@ def test_intervals_that_need_too_many_substeps_are_left_to_the_integrator():
     position = np.array([[0.0, 0.0], [0.001, 0.0]])
     state = [position, np.zeros((2, 2)), np.zeros((2, 2))]
     flown, after = smooth_intervals(*state, np.ones(2), np.zeros(2), np.array([1.0, -1.0]), 5.0,
-                                    0.0, BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0, 1.0, 4, 2, 1e-4, 16,
-                                    FLOOR, np.empty((4, len(RECORD))))  # fmt: skip
+                                    0.0, *FREE, BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0, 1.0, 4, 2,
+                                    1e-4, 16, FLOOR, np.empty((4, len(RECORD))))  # fmt: skip
     assert (flown, after) == (0, 2)
     np.testing.assert_array_equal(state[0], [[0.0, 0.0], [0.001, 0.0]])
 

@@ -107,6 +107,28 @@ class DirectPairForce(PositionForce, Protocol):
         `collidium.kernels.pairwise` here, else None."""
 
 
+@runtime_checkable
+class UniformPositionForce(PositionForce, Protocol):
+    """A position force that is a constant force on each particle (a uniform field), which the
+    compiled substeps can kick with (`collidium.kernels.substeps`)."""
+
+    def uniform_force(self, particles: Particles) -> FloatArray:
+        """The force on each particle (N, 2), N: the same at every position."""
+
+
+@runtime_checkable
+class TurningForce(VelocityForce, Protocol):
+    """A velocity force that turns each velocity at a constant rate inside a rectangle (a
+    magnetic field), which the compiled substeps can apply (`collidium.kernels.substeps`)."""
+
+    def cyclotron(self, particles: Particles) -> FloatArray:
+        """Each particle's signed rate of turning (N,), rad/s, where the force acts; a
+        velocity turns by ``-rate h`` in ``h`` seconds (clockwise for a positive rate)."""
+
+    def bounds(self) -> FloatArray:
+        """Where the force acts: ``(left, bottom, right, top)`` in m, infinite for the plane."""
+
+
 #: Every force by its name (filled as the force modules are imported).
 FORCES: dict[str, type[Force]] = {}
 
@@ -210,6 +232,69 @@ def check_rectangle(
     return low, high
 
 
+@dataclasses.dataclass(frozen=True, eq=False)
+class CompiledForces:
+    """The forces as the compiled substeps take them (`ForceField.compiled`).
+
+    Attributes
+    ----------
+    source : str or None
+        The particles' property that holds the pair force's sources ("charge" or "mass"), None
+        without a pair force.
+    coupling, softening2 : float
+        The pair force's coupling (N m^2 per source squared) and squared softening (m^2); 0
+        without one.
+    uniform : ndarray, shape (N, 2) or (0, 2)
+        The uniform field's force on each particle, N (none: empty).
+    turn : ndarray, shape (N,) or (0,)
+        The magnetic field's signed cyclotron frequencies, rad/s (none: empty).
+    region : ndarray, shape (4,)
+        Where the magnetic field acts: left, bottom, right, top, m.
+    """
+
+    source: str | None
+    coupling: float
+    softening2: float
+    uniform: FloatArray
+    turn: FloatArray
+    region: FloatArray
+
+
+_WHOLE_PLANE = np.array([-np.inf, -np.inf, np.inf, np.inf])
+
+_Parts = tuple[DirectPairForce | None, UniformPositionForce | None, TurningForce | None]
+
+
+def _compiled_parts(
+    position: tuple[PositionForce, ...],
+    velocity: tuple[VelocityForce, ...],
+    carried: tuple[bool, ...],
+) -> _Parts | None:
+    """The forces as ``(pair sum, uniform field, magnetic field)``, each None if absent, or None
+    if there is more than one of a kind, a force of another kind, a force the drift carries, or
+    no force at all (`ForceField.compiled`)."""
+    pairs = [f for f in position if isinstance(f, DirectPairForce)]
+    uniform = [f for f in position if isinstance(f, UniformPositionForce)]
+    turning = [f for f in velocity if isinstance(f, TurningForce)]
+    if (
+        any(carried)
+        or len(pairs) + len(uniform) != len(position)
+        or len(turning) != len(velocity)
+        or max(len(pairs), len(uniform), len(turning)) > 1
+        or not (position or velocity)
+    ):
+        return None
+    return _one(pairs), _one(uniform), _one(turning)
+
+
+_Kind = TypeVar("_Kind")
+
+
+def _one(forces: list[_Kind]) -> _Kind | None:
+    """The one force of a list of at most one, or None."""
+    return forces[0] if forces else None
+
+
 def _refuse_infinite(acceleration: FloatArray) -> None:
     """One line naming the first particle whose acceleration (N, 2) overflowed (a force on a
     mass too small to move by it)."""
@@ -257,8 +342,9 @@ class ForceField:
         self._velocity = tuple(f for f in self.forces if isinstance(f, VelocityForce))
         #: Per position force: whether the drift carries it (no kicks).
         self._carried = tuple(carry_fall and f.fall is not None for f in self._position)
-        #: Whether every position force may be a direct pair sum (a protocol check is slow).
-        self._direct = all(isinstance(f, DirectPairForce) for f in self._position)
+        #: The forces by the part the compiled substeps give them (`compiled`; a protocol
+        #: check is slow), or None where a force is none of those parts.
+        self._compiled = _compiled_parts(self._position, self._velocity, self._carried)
         self._fall = np.zeros(2)
         for force, carried in zip(self._position, self._carried, strict=True):
             if carried:
@@ -343,14 +429,30 @@ class ForceField:
         self._evaluated_at = particles.position.copy()
         return self._acceleration
 
-    def direct_term(self, particles: Particles, vessel: Vessel) -> tuple[str, float, float] | None:
-        """The force as the compiled substeps sum it (`collidium.kernels.substeps`): the
-        particles' property that holds its sources, its coupling and its squared softening (m^2),
-        when the field's one force is a direct inverse-distance pair sum
-        (`DirectPairForce.direct_term`); None otherwise."""
-        if self._velocity or len(self._position) != 1 or not self._direct:
+    def compiled(self, particles: Particles, vessel: Vessel) -> CompiledForces | None:
+        """The forces as the compiled substeps take them (`collidium.kernels.substeps`), or
+        None unless they are at most one direct inverse-distance pair sum
+        (`DirectPairForce.direct_term`), one uniform field that the drift does not carry
+        (`UniformPositionForce`) and one magnetic field (`TurningForce`), and at least one of
+        them."""
+        if self._compiled is None:
             return None
-        return typing.cast(DirectPairForce, self._position[0]).direct_term(particles, vessel)
+        pair, uniform, turning = self._compiled
+        term = ("charge", 0.0, 0.0)  # no pair force: its sources are all 0
+        if pair is not None:
+            found = pair.direct_term(particles, vessel)
+            if found is None:
+                return None
+            term = found
+        name, coupling, softening2 = term
+        return CompiledForces(
+            name if pair is not None else None,
+            coupling,
+            softening2,
+            np.empty((0, 2)) if uniform is None else uniform.uniform_force(particles),
+            np.empty(0) if turning is None else turning.cyclotron(particles),
+            _WHOLE_PLANE if turning is None else turning.bounds(),
+        )
 
     def stiffness(self, particles: Particles, vessel: Vessel) -> float:
         """``S`` of all forces at the current state, in J^2/s^4: the largest of the forces'

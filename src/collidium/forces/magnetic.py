@@ -46,13 +46,25 @@ class MagneticField:
     def check(self, particles: Particles, vessel: Vessel) -> None:
         """Any vessel will do."""
 
+    def cyclotron(self, particles: Particles) -> np.ndarray:
+        """Each particle's signed cyclotron frequency ``q B / m`` (N,), rad/s, inside the
+        `region` (`collidium.forces.base.TurningForce`)."""
+        return np.asarray(particles.charge * self.B / particles.mass)
+
+    def bounds(self) -> np.ndarray:
+        """The `region` as ``(left, bottom, right, top)`` in m, infinite for the whole plane."""
+        if self.region is None:
+            return np.array([-np.inf, -np.inf, np.inf, np.inf])
+        (left, bottom), (right, top) = self.region
+        return np.array([left, bottom, right, top])
+
     def frequency(self, particles: Particles) -> np.ndarray:
         """Each particle's signed cyclotron frequency ``q B / m`` (N,), rad/s, where it is
         (0 outside the `region`)."""
-        omega = np.asarray(particles.charge * self.B / particles.mass)
+        omega = self.cyclotron(particles)
         if self.region is None:
             return omega
-        (left, bottom), (right, top) = self.region
+        left, bottom, right, top = self.bounds()
         x, y = particles.position[:, 0], particles.position[:, 1]
         inside = (x >= left) & (x <= right) & (y >= bottom) & (y <= top)
         return np.where(inside, omega, 0.0)

@@ -45,10 +45,7 @@ class UniformForce:
     ) -> None:
         """``s_i f`` on each particle, ``-s_i f . x_i`` its energy, no virial
         (`collidium.forces.base.Force.compute`)."""
-        fx, fy = getattr(self, self.vector)
-        strength = getattr(particles, self.source)
-        force[:, 0] = strength * fx
-        force[:, 1] = strength * fy
+        force[...] = self.uniform_force(particles)
         if not energies:
             return
         position = particles.position
@@ -56,6 +53,16 @@ class UniformForce:
             position = position + particles.image * vessel.size
         energy[...] = -(position[:, 0] * force[:, 0] + position[:, 1] * force[:, 1])
         virial[...] = 0.0
+
+    def uniform_force(self, particles: Particles) -> FloatArray:
+        """``s_i f`` on each particle (N, 2), N
+        (`collidium.forces.base.UniformPositionForce`)."""
+        fx, fy = getattr(self, self.vector)
+        strength = getattr(particles, self.source)
+        force = np.empty((particles.n, 2))
+        force[:, 0] = strength * fx
+        force[:, 1] = strength * fy
+        return force
 
     def stiffness(self, particles: Particles, vessel: Vessel, acceleration: FloatArray) -> float:
         """0: leapfrog follows a uniform force exactly."""

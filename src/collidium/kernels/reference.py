@@ -847,6 +847,9 @@ def smooth_substeps(
     source: FloatArray,
     coupling: float,
     softening2: float,
+    uniform: FloatArray,
+    turn: FloatArray,
+    region: FloatArray,
     shape: int,
     half: FloatArray,
     rim: float,
@@ -864,19 +867,20 @@ def smooth_substeps(
     """Twin of `substeps.smooth_substeps` in a box of half sides ``half`` (``shape`` `BOX`), a
     circle of radius ``rim`` (`CIRCLE`) or neither, and against the segments of ``table``.
 
-    Each substep: the kick; the contact test on all pairs and walls at once (contacts within
-    ``margin`` of a radius, or of the substep); the straight flight; the force
-    (`inverse_distance_direct`); the squared rate from the ``total`` energy (`squared_rate`).
-    Updates the motion in place and returns ``(substep not taken, its start, fastest)``.
+    Each substep: the magnetic turn (`turned`) and the kick; the contact test on all pairs and
+    walls at once (contacts within ``margin`` of a radius, or of the substep); the straight
+    flight; the force (`inverse_distance_direct` and the ``uniform`` field's); the kick and
+    the turn; the squared rate from the ``total`` energy (`squared_rate`). Updates the motion
+    in place and returns ``(substep not taken, its start, fastest)``.
     """
     zero = np.zeros(2)
     if fastest < 0.0:
-        fastest = squared_rate(position, velocity, mass, source, coupling, softening2, total,
-                               energy_floor)  # fmt: skip
+        fastest = squared_rate(position, velocity, mass, source, coupling, softening2, turn,
+                               total, energy_floor)  # fmt: skip
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
-        kicked = velocity + 0.5 * h * acceleration
+        kicked = turned(position, velocity, turn, region, 0.5 * h) + 0.5 * h * acceleration
         wide = radius * (1.0 + margin)
         wall = math.inf
         if shape == CIRCLE:
@@ -895,17 +899,33 @@ def smooth_substeps(
         if not np.isfinite(kicked).all() or wall <= h * (1.0 + margin) or np.triu(meets, 1).any():
             return s, t, fastest
         flown = position + kicked * h
-        pull = inverse_distance_direct(flown, source, coupling, softening2)[0] / mass[:, None]
+        force = inverse_distance_direct(flown, source, coupling, softening2)[0]
+        pull = (force + uniform if uniform.size else force) / mass[:, None]
         if not np.isfinite(pull).all():
             return s, t, fastest
         position[...] = flown
-        velocity[...] = kicked + 0.5 * h * pull
+        velocity[...] = turned(flown, kicked + 0.5 * h * pull, turn, region, 0.5 * h)
         acceleration[...] = pull
         t = end
-        rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, total,
+        rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, turn, total,
                              energy_floor)  # fmt: skip
         fastest = max(fastest, rate2)
     return count + 1, t, fastest
+
+
+def turned(
+    position: FloatArray, velocity: FloatArray, turn: FloatArray, region: FloatArray, lag: float
+) -> FloatArray:
+    """Twin of the substeps' magnetic flow: the velocities (N, 2) of the particles inside
+    ``region`` (left, bottom, right, top) turned by ``-turn lag`` (a new array)."""
+    if turn.size == 0:
+        return velocity.copy()
+    x, y = position[:, 0], position[:, 1]
+    inside = (x >= region[0]) & (x <= region[2]) & (y >= region[1]) & (y <= region[3])
+    angle = np.where(inside, -turn * lag, 0.0)
+    cos, sin = np.cos(angle), np.sin(angle)
+    vx, vy = velocity[:, 0], velocity[:, 1]
+    return np.stack([cos * vx - sin * vy, sin * vx + cos * vy], axis=1)
 
 
 def squared_rate(
@@ -915,16 +935,19 @@ def squared_rate(
     source: FloatArray,
     coupling: float,
     softening2: float,
+    turn: FloatArray,
     total: float,
     energy_floor: float,
 ) -> float:
     """Twin of the substeps' rate: the square root of the stiffness
     (`inverse_distance_stiffness`) over the energy scale, ``|E|`` (``total``) but at least
-    ``(KE + |U|) / energy_floor`` with ``U = E - KE``."""
+    ``(KE + |U|) / energy_floor`` with ``U = E - KE``; or the fastest cyclotron frequency
+    ``turn`` squared, if larger."""
     stiffness = inverse_distance_stiffness(position, velocity, source, mass, coupling, softening2)
     kinetic = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1)))
     scale = max(abs(total), (kinetic + abs(total - kinetic)) / energy_floor)
-    return math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
+    energy = math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
+    return max(energy, float(np.max(np.abs(turn), initial=0.0)) ** 2)
 
 
 def needed(rate2: float, dt: float, tolerance: float, most: int) -> int:
@@ -945,6 +968,9 @@ def smooth_intervals(
     source: FloatArray,
     coupling: float,
     softening2: float,
+    uniform: FloatArray,
+    turn: FloatArray,
+    region: FloatArray,
     shape: int,
     half: FloatArray,
     rim: float,
@@ -969,7 +995,8 @@ def smooth_intervals(
     def energies() -> tuple[float, float, float]:
         moving = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1)))
         _, energy, virial = inverse_distance_direct(position, source, coupling, softening2)
-        return moving, float(energy.sum()), float(virial.sum())
+        field = -float(np.sum(position * uniform)) if uniform.size else 0.0
+        return moving, float(energy.sum()) + field, float(virial.sum())
 
     def table_row() -> tuple[float, ...]:
         px, py = mass @ velocity
@@ -979,7 +1006,7 @@ def smooth_intervals(
     for k in range(count):
         now = origin + (elapsed + k) * dt
         total = sum(energies()[:2])
-        rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, total,
+        rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, turn, total,
                              energy_floor)  # fmt: skip
         if not dt * math.sqrt(rate2) <= most * tolerance:
             return k, substeps, np.array(record).reshape(-1, 6)
@@ -988,8 +1015,8 @@ def smooth_intervals(
         while True:
             reached, _, fastest = smooth_substeps(
                 position, velocity, acceleration, mass, radius, source, coupling, softening2,
-                shape, half, rim, table, now, dt, 1, taken, now, rate2, total, energy_floor,
-                margin,
+                uniform, turn, region, shape, half, rim, table, now, dt, 1, taken, now, rate2,
+                total, energy_floor, margin,
             )  # fmt: skip
             met = reached <= taken
             required = needed(fastest, dt, tolerance, most)

@@ -53,18 +53,19 @@ def energy_scale(kinetic: float, total: float, floor: float) -> float:
 
 @numba.njit(cache=True, error_model="numpy")
 def smooth_substeps(
-    position, velocity, acceleration, mass, radius, source, coupling, softening2,
-    shape, half_width, half_height, rim, segments, now, dt, first, count, t, fastest, total,
-    energy_floor,
+    position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, turn,
+    region, shape, half_width, half_height, rim, segments, now, dt, first, count, t, fastest,
+    total, energy_floor,
 ) -> tuple[int, float, float]:  # fmt: skip
     """Regular substeps ``first, first + 1, ...`` of ``count`` in the interval from ``now`` of
     ``dt`` (s), in place, up to the first that may meet a contact.
 
-    Substep s ends at ``now + dt s / count``; it is a kick ``v += a h / 2``, the straight flight
-    over h, the accelerations at the new positions and the kick ``v += a h / 2``. After each,
-    the squared rate of the forces weighted by energy (`collidium.integrators._squared_rate`)
-    raises ``fastest``. No energy is summed: the rate's energy scale takes the potential as the
-    ``total`` energy less the kinetic (the forces conserve the total to the tolerance).
+    Substep s ends at ``now + dt s / count``; it is the magnetic field's turn for ``h / 2``, a
+    kick ``v += a h / 2``, the straight flight over h, the accelerations at the new positions,
+    the kick ``v += a h / 2`` and the turn for ``h / 2``. After each, the squared rate of the
+    forces weighted by energy (`collidium.integrators._squared_rate`) raises ``fastest``. No
+    energy is summed: the rate's energy scale takes the potential as the ``total`` energy less
+    the kinetic (the forces conserve the total to the tolerance).
 
     Parameters
     ----------
@@ -76,6 +77,13 @@ def smooth_substeps(
         The pair force's sources (`collidium.kernels.pairwise.inverse_distance_direct`).
     coupling, softening2 : float
         Its coupling (N m^2 per source squared) and squared softening (m^2).
+    uniform : ndarray, shape (N, 2) or (0, 2)
+        A uniform field's force on each particle, N; empty without one.
+    turn : ndarray, shape (N,) or (0,)
+        A magnetic field's signed cyclotron frequency ``q B / m`` of each particle, rad/s
+        (`_turn`); empty without one.
+    region : ndarray, shape (4,)
+        Where the magnetic field acts: left, bottom, right, top (m), infinite for the plane.
     shape, half_width, half_height, rim, segments
         The vessel as the exact engine has it (`collidium.kernels.vessels.contacts.earliest`).
     now, dt : float
@@ -101,15 +109,17 @@ def smooth_substeps(
     """
     work = _work(mass, source)
     walls = (shape, half_width, half_height, rim, segments)
-    return _substeps(position, velocity, acceleration, mass, radius, coupling, softening2, walls,
-                     now, dt, first, count, t, fastest, total, energy_floor, work)  # fmt: skip
+    external = (uniform, turn, region)
+    return _substeps(position, velocity, acceleration, mass, radius, coupling, softening2,
+                     external, walls, now, dt, first, count, t, fastest, total, energy_floor,
+                     work)  # fmt: skip
 
 
 @numba.njit(cache=True, error_model="numpy")
 def smooth_intervals(
-    position, velocity, acceleration, mass, radius, source, coupling, softening2,
-    shape, half_width, half_height, rim, segments, origin, elapsed, dt, count, substeps,
-    tolerance, most_substeps, energy_floor, record,
+    position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, turn,
+    region, shape, half_width, half_height, rim, segments, origin, elapsed, dt, count,
+    substeps, tolerance, most_substeps, energy_floor, record,
 ) -> tuple[int, int]:  # fmt: skip
     """Up to ``count`` whole reporting intervals of ``dt`` (s), in place, each as the adaptive
     integrator takes one (`collidium.integrators.AdaptiveLeapfrog`), up to the first that meets
@@ -123,8 +133,8 @@ def smooth_intervals(
 
     Parameters
     ----------
-    position, velocity, acceleration, mass, radius, source, coupling, softening2, shape,
-    half_width, half_height, rim, segments
+    position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform,
+    turn, region, shape, half_width, half_height, rim, segments
         As in `smooth_substeps`.
     origin : float
         The clock's origin, s.
@@ -144,7 +154,7 @@ def smooth_intervals(
         As in `smooth_substeps`.
     record : ndarray, shape (count, len(RECORD))
         Output: the `RECORD` of each interval's end, summed as `collidium.simulation.Simulation`
-        sums them (`collidium.kernels.sums`, and the pair force's as
+        sums them (`collidium.kernels.sums`, and the forces' as
         `collidium.forces.base.ForceField` sums them).
 
     Returns
@@ -155,22 +165,23 @@ def smooth_intervals(
     n = position.shape[0]
     work = _work(mass, source)
     walls = (shape, half_width, half_height, rim, segments)
+    external = (uniform, turn, region)
     start = np.empty((3, n, 2))
     sources = work[3:12]
-    energy, virial = _energies(position, coupling, softening2, sources)
+    energy, virial = _energies(position, coupling, softening2, uniform, sources)
     for k in range(count):
         now = origin + (elapsed + k) * dt
         total = kinetic_energy(mass, velocity) + energy
-        rate2 = _squared_rate(position, velocity, mass, coupling, softening2, total, energy_floor,
-                              sources)  # fmt: skip
+        rate2 = _squared_rate(position, velocity, mass, coupling, softening2, turn, total,
+                              energy_floor, sources)  # fmt: skip
         if not dt * math.sqrt(rate2) <= most_substeps * tolerance:  # also NaN
             return k, substeps
         taken = max(substeps, needed(rate2, dt, tolerance, most_substeps))
         _keep(position, velocity, acceleration, start)
         while True:
             s, _, fastest = _substeps(position, velocity, acceleration, mass, radius, coupling,
-                                      softening2, walls, now, dt, 1, taken, now, rate2, total,
-                                      energy_floor, work)  # fmt: skip
+                                      softening2, external, walls, now, dt, 1, taken, now, rate2,
+                                      total, energy_floor, work)  # fmt: skip
             if s <= taken:  # a contact, or a value not finite
                 _restore(position, velocity, acceleration, start)
                 return k, substeps
@@ -180,7 +191,7 @@ def smooth_intervals(
             _restore(position, velocity, acceleration, start)
             taken = max(required, 2 * taken)
         substeps = max(1, taken // 2) if required <= taken // 2 else taken
-        energy, virial = _energies(position, coupling, softening2, sources)
+        energy, virial = _energies(position, coupling, softening2, uniform, sources)
         px, py = momentum(mass, velocity)
         record[k, 0] = kinetic_energy(mass, velocity)
         record[k, 1] = energy
@@ -231,9 +242,10 @@ def _work(mass, source):
 
 
 @uncounted(error_model="numpy")
-def _substeps(position, velocity, acceleration, mass, radius, coupling, softening2, walls, now,
-              dt, first, count, t, fastest, total, energy_floor, work):  # fmt: skip
-    """`smooth_substeps` in its work arrays (`_work`), the vessel as one tuple.
+def _substeps(position, velocity, acceleration, mass, radius, coupling, softening2, external,
+              walls, now, dt, first, count, t, fastest, total, energy_floor, work):  # fmt: skip
+    """`smooth_substeps` in its work arrays (`_work`), the uniform and magnetic fields as one
+    tuple (``uniform, turn, region``), the vessel as another.
 
     Compiled without reference counting (`uncounted`), as are the pair sums it calls: the
     atomic counts numba puts around array arguments were 0.35 us of a two-body substep's
@@ -241,24 +253,26 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     kicked, flown, pull = work[:3]
     index, charged, inverse_mass, x, y, vx, vy, sums, buffer = work[3:12]
     order, low, high = work[12:]
+    uniform, turn, region = external
     n = position.shape[0]
     if fastest < 0.0:
-        fastest = _squared_rate(position, velocity, mass, coupling, softening2, total,
+        fastest = _squared_rate(position, velocity, mass, coupling, softening2, turn, total,
                                 energy_floor, work[3:12])  # fmt: skip
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
+        _turn(position, velocity, turn, region, 0.5 * h, kicked)
         for i in range(n):
             for d in range(2):
-                kicked[i, d] = velocity[i, d] + (0.5 * h) * acceleration[i, d]
+                kicked[i, d] += (0.5 * h) * acceleration[i, d]
         if not _finite(kicked) or _meets_contact(position, kicked, radius, h, walls, order, low,
                                                  high):  # fmt: skip
             return s, t, fastest
         for i in range(n):
             for d in range(2):
                 flown[i, d] = position[i, d] + kicked[i, d] * h
-        _accelerations(flown, mass, coupling, softening2, index, charged, x, y, sums, buffer,
-                       pull)  # fmt: skip
+        _accelerations(flown, mass, coupling, softening2, uniform, index, charged, x, y, sums,
+                       buffer, pull)  # fmt: skip
         if not _finite(pull):
             return s, t, fastest
         for i in range(n):
@@ -266,9 +280,10 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
                 position[i, d] = flown[i, d]
                 velocity[i, d] = kicked[i, d] + (0.5 * h) * pull[i, d]
                 acceleration[i, d] = pull[i, d]
+        _turn(position, velocity, turn, region, 0.5 * h, velocity)
         t = end
-        rate2 = _rate(position, velocity, mass, coupling, softening2, total, energy_floor, index,
-                      charged, inverse_mass, x, y, vx, vy)  # fmt: skip
+        rate2 = _rate(position, velocity, mass, coupling, softening2, turn, total, energy_floor,
+                      index, charged, inverse_mass, x, y, vx, vy)  # fmt: skip
         if rate2 > fastest:
             fastest = rate2
     return count + 1, t, fastest
@@ -316,9 +331,10 @@ def _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffe
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _accelerations(position, mass, coupling, softening2, index, charged, x, y, sums, buffer,
-                   out) -> None:  # fmt: skip
-    """The accelerations (N, 2) of the pair force into ``out``: its forces over the masses, as
+def _accelerations(position, mass, coupling, softening2, uniform, index, charged, x, y, sums,
+                   buffer, out) -> None:  # fmt: skip
+    """The accelerations (N, 2) of the pair force and the ``uniform`` field's forces (N, 2), or
+    (0, 2) without one) into ``out``: the forces over the masses, as
     `collidium.forces.base.ForceField.evaluate` forms them (`_pair_sums`)."""
     _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffer)
     for i in range(position.shape[0]):  # loops: an array expression costs more than 3 bodies
@@ -327,17 +343,22 @@ def _accelerations(position, mass, coupling, softening2, index, charged, x, y, s
     for c in range(index.shape[0]):
         out[index[c], 0] += sums[0, c]
         out[index[c], 1] += sums[1, c]
+    for i in range(uniform.shape[0]):
+        out[i, 0] += uniform[i, 0]
+        out[i, 1] += uniform[i, 1]
     for i in range(position.shape[0]):
         out[i, 0] /= mass[i]
         out[i, 1] /= mass[i]
 
 
 @uncounted(error_model="numpy")
-def _energies(position, coupling, softening2, sources) -> tuple[float, float]:
-    """The potential energy and the pair virial (J) of the pair force: its pair sums halved to
-    the particles and summed in particle order, as `collidium.forces.base.ForceField` sums them
-    (`collidium.kernels.sums.ordered_sum`; the particles without a source add nothing).
-    ``sources``: the arrays of `_work` from the indices to the sums' buffer."""
+def _energies(position, coupling, softening2, uniform, sources) -> tuple[float, float]:
+    """The potential energy and the pair virial (J) as `collidium.forces.base.ForceField` sums
+    them, force by force: the pair force's pair sums halved to the particles and summed in
+    particle order (`collidium.kernels.sums.ordered_sum`; the particles without a source add
+    nothing), and the ``uniform`` field's ``-F_i . x_i`` in particle order
+    (`collidium.forces.uniform`; no virial). Two sums added to 0 in either order give the same
+    bits. ``sources``: the arrays of `_work` from the indices to the sums' buffer."""
     index, charged, _, x, y, _, _, sums, buffer = sources
     _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffer)
     energy = 0.0
@@ -345,24 +366,30 @@ def _energies(position, coupling, softening2, sources) -> tuple[float, float]:
     for c in range(sums.shape[1]):
         energy += 0.5 * sums[2, c]
         virial += 0.5 * sums[3, c]
-    return 0.0 + energy, 0.0 + virial  # the field adds its forces' sums to 0
+    field = 0.0
+    for i in range(uniform.shape[0]):
+        field += -(position[i, 0] * uniform[i, 0] + position[i, 1] * uniform[i, 1])
+    return 0.0 + energy + field, 0.0 + virial  # the field adds its forces' sums to 0
 
 
 @uncounted(error_model="numpy")
-def _squared_rate(position, velocity, mass, coupling, softening2, total, floor, sources) -> float:
+def _squared_rate(position, velocity, mass, coupling, softening2, turn, total, floor,
+                  sources) -> float:  # fmt: skip
     """`_rate` with the arrays of `_work` from the indices to the sums' buffer (``sources``)."""
     index, charged, inverse_mass, x, y, vx, vy, _, _ = sources
-    return _rate(position, velocity, mass, coupling, softening2, total, floor, index, charged,
-                 inverse_mass, x, y, vx, vy)  # fmt: skip
+    return _rate(position, velocity, mass, coupling, softening2, turn, total, floor, index,
+                 charged, inverse_mass, x, y, vx, vy)  # fmt: skip
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")  # that of the inlined rows
-def _rate(position, velocity, mass, coupling, softening2, total, floor, index, charged,
+def _rate(position, velocity, mass, coupling, softening2, turn, total, floor, index, charged,
           inverse_mass, x, y, vx, vy) -> float:  # fmt: skip
-    """`collidium.integrators._squared_rate` of the pair force alone, 1/s^2, given the total
-    energy (J): the square root of the largest ``(|U_ij| rate_ij^2)^2`` over pairs
+    """`collidium.integrators._squared_rate`, 1/s^2, given the total energy (J): the square
+    root of the largest ``(|U_ij| rate_ij^2)^2`` over pairs
     (`collidium.kernels.pairwise.inverse_distance_stiffness`, by its rows, from the particles
-    with a source ``index`` gathered into ``x, y, vx, vy``) over the energy scale."""
+    with a source ``index`` gathered into ``x, y, vx, vy``) over the energy scale, or the
+    square of the fastest cyclotron frequency ``turn`` (inside the field's region or not, as
+    `collidium.forces.magnetic.MagneticField.rate`), whichever is larger."""
     for c in range(index.shape[0]):
         i = index[c]
         x[c], y[c] = position[i, 0], position[i, 1]
@@ -373,7 +400,29 @@ def _rate(position, velocity, mass, coupling, softening2, total, floor, index, c
                             0.0, False)  # fmt: skip
         stiffness = larger(stiffness, row)
     scale = energy_scale(kinetic_energy(mass, velocity), total, floor)
-    return math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
+    energy = math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
+    spin = 0.0
+    for i in range(turn.shape[0]):
+        spin = max(spin, abs(turn[i]))
+    return max(energy, spin * spin)
+
+
+@numba.njit(cache=True, inline="always")
+def _turn(position, velocity, turn, region, lag, out) -> None:
+    """The magnetic field's flow for ``lag`` seconds: each velocity (N, 2) of a particle inside
+    the ``region`` (left, bottom, right, top, m) at ``position`` turned by ``-turn lag``
+    (`collidium.forces.magnetic.MagneticField.advance`), into ``out`` (which may be
+    ``velocity``); the others copied. Without a field (``turn`` empty), a copy."""
+    left, bottom, right, top = region[0], region[1], region[2], region[3]
+    for i in range(velocity.shape[0]):
+        vx, vy = velocity[i, 0], velocity[i, 1]
+        x, y = position[i, 0], position[i, 1]
+        if turn.shape[0] > 0 and left <= x <= right and bottom <= y <= top:
+            angle = -turn[i] * lag
+            cos, sin = math.cos(angle), math.sin(angle)
+            vx, vy = cos * vx - sin * vy, sin * vx + cos * vy
+        out[i, 0] = vx
+        out[i, 1] = vy
 
 
 @numba.njit(cache=True, inline="always")
