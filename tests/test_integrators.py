@@ -257,6 +257,7 @@ def test_bad_integrator_settings_name_the_field(field, value):
         ("charged-gas", 0.1, 1e-10),  # 200 disks, a contact in most regular substeps
         ("spectrometer", 10.0, 1e-10),  # a magnetic field over a part of the box; the floor
         ("projectile", 5.0, 1e-10),  # a uniform field; the floor
+        ("drag", 10.0, 1e-10),  # a carried gravity and drag
     ],
 )
 def test_compiled_substeps_give_the_python_run_to_round_off(monkeypatch, name, time, atol):
@@ -311,34 +312,32 @@ def smooth_flight(sim: cd.Simulation) -> object:
     return integrators._SmoothFlight.of(sim.particles, sim.container, sim._field)
 
 
-def test_compiled_substeps_take_a_pair_sum_and_external_fields_between_fixed_walls():
-    """At most one of each: a direct pair sum, a uniform field the drift does not carry, a
-    magnetic field."""
-    for name in ("orbit", "charged-gas", "spectrometer", "projectile"):
+def test_compiled_substeps_take_a_pair_sum_fields_and_drag_between_fixed_walls():
+    """At most one of each: a direct pair sum, a uniform field (carried by the drift or not), a
+    magnetic field, a linear drag."""
+    for name in ("orbit", "charged-gas", "spectrometer", "projectile", "drag"):
         assert smooth_flight(cd.load(name)) is not None
     sim = cd.load("orbit")
     taken = {
-        "a pair sum and both fields": [
-            cd.Coulomb(),
-            cd.UniformField(E=[1.0, 0.0]),
-            cd.MagneticField(B=1.0),
-        ],
+        "all four": [cd.Coulomb(), cd.UniformField(E=[1.0, 0.0]), cd.MagneticField(B=1.0),
+                     cd.LinearDrag(gamma=1.0)],
         "Newton's pair sum and a magnetic field": [cd.Newton(G=1.0), cd.MagneticField(B=1.0)],
-        "gravity by kicks": [cd.Gravity((0.0, -1.0))],
-    }
-    sim.collisions = "step"  # whose drift carries no fall
+        "a gravity the drift carries": [cd.Coulomb(), cd.Gravity((0.0, -1.0))],
+    }  # fmt: skip
     for forces in taken.values():
         sim.forces = forces
         assert smooth_flight(sim) is not None
+    sim.collisions = "step"  # whose drift carries no fall: the gravity is kicked
+    assert smooth_flight(sim) is not None
     sim = cd.load("orbit")
     excluded = {
         "two pair forces": [cd.Coulomb(), cd.Newton(G=1.0)],
         "a tree sum": [cd.Coulomb(method="tree")],
         "a limiter": [cd.Coulomb(max_acceleration=10.0)],
-        "drag": [cd.Coulomb(), cd.LinearDrag(gamma=1.0)],
+        "quadratic drag": [cd.Coulomb(), cd.QuadraticDrag(c=1.0)],
         "two uniform fields": [cd.UniformField(E=[1.0, 0.0]), cd.Gravity((0.0, -1.0))],
         "two magnetic fields": [cd.MagneticField(B=1.0), cd.MagneticField(B=2.0)],
-        "a gravity the drift carries": [cd.Coulomb(), cd.Gravity((0.0, -1.0))],
+        "two drags": [cd.LinearDrag(gamma=1.0), cd.LinearDrag(gamma=2.0)],
     }
     for forces in excluded.values():
         sim.forces = forces

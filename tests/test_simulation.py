@@ -363,7 +363,7 @@ class StateReader:
 @pytest.mark.parametrize(
     ("name", "time"),
     [("orbit", 3.0), ("bohr-atom", 1.0), ("charged-opposite", 8.0), ("charged-gas", 0.1),
-     ("spectrometer", 10.0), ("projectile", 5.0)],
+     ("spectrometer", 10.0), ("projectile", 5.0), ("drag", 10.0)],
 )  # fmt: skip
 def test_steps_flown_in_one_call_are_bitwise_those_taken_one_by_one(name, time):
     """A small charged scene flies the steps between the observers that read its state in one
@@ -372,7 +372,8 @@ def test_steps_flown_in_one_call_are_bitwise_those_taken_one_by_one(name, time):
     energy series, the thermodynamics and the collision counts every third) measure bit for bit
     the same. charged-opposite collides, the charged gas meets a contact in most substeps; the
     spectrometer's ions turn in a magnetic field and land on the floor, the projectile falls
-    in a uniform field (its potential energy in the record) and bounces."""
+    in a uniform field (its potential energy in the record) and bounces, the drag's disks fall
+    through a fluid (the energy it takes in the record)."""
     runs = []
     for reader in (StateReader(Every(250)), StateReader(Every(1))):
         sim = cd.load(name)

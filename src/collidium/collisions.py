@@ -101,6 +101,8 @@ class FlightRecord:
         leave the rows of the steps not ``wanted`` unwritten.
     counts, impulse, heat : ndarray, shape (K, 1 + W)
         The `Tally`'s.
+    forces : ndarray, shape (K,)
+        The `Tally`'s energy given by the velocity forces.
     wanted : ndarray of bool, shape (K,)
         The steps whose ``values`` an observer reads.
     """
@@ -109,6 +111,7 @@ class FlightRecord:
     counts: IntArray
     impulse: FloatArray
     heat: FloatArray
+    forces: FloatArray
     wanted: BoolArray
 
     @classmethod
@@ -120,6 +123,7 @@ class FlightRecord:
             np.empty((steps, size), dtype=np.int64),
             np.empty((steps, size)),
             np.empty((steps, size)),
+            np.empty(steps),
             wanted,
         )
 

@@ -168,7 +168,9 @@ class Integrator:
                                          record)  # fmt: skip
         if field.active and not field.falls_alone:  # the record has no other potential
             return 0
-        return drift.fly(particles, vessel, origin, elapsed, dt, tally, record, field.fall)
+        taken = drift.fly(particles, vessel, origin, elapsed, dt, tally, record, field.fall)
+        record.forces[:taken] = tally.forces[0]  # no velocity force gave any
+        return taken
 
     def _flies_with_forces(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
         """Whether `_fly_with_forces` may take steps here (none by default)."""
@@ -307,7 +309,7 @@ class AdaptiveLeapfrog(Integrator):
         flight = self._flight_for(particles, vessel, field)
         tried = flight is not None and not self.next_in_python
         if tried and self._intervals(typing.cast(_SmoothFlight, flight), particles, field, now,
-                                     0, dt, _ONE):  # fmt: skip
+                                     0, dt, tally, _ONE, _ONE_HEAT):  # fmt: skip
             return  # the interval met no contact: compiled whole
         start = _Snapshot(particles, tally)
         # The energy the substeps' rate is judged against: the interval's one read of the
@@ -352,8 +354,8 @@ class AdaptiveLeapfrog(Integrator):
         return self._flight
 
     def _flies_with_forces(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
-        """Whether `_fly_with_forces` may take steps here: one force, a direct pair sum, in a
-        small scene (`_SmoothFlight.of`), and a next interval not left to Python."""
+        """Whether `_fly_with_forces` may take steps here: forces that the compiled substeps
+        take, in a small scene (`_SmoothFlight.of`), and a next interval not left to Python."""
         return not self.next_in_python and self._flight_for(particles, vessel, field) is not None
 
     def _fly_with_forces(
@@ -370,11 +372,12 @@ class AdaptiveLeapfrog(Integrator):
         """Whole intervals that meet no contact, compiled
         (`collidium.kernels.substeps.smooth_intervals`): `step` takes each such interval by the
         same call, so both give the same bits. They touch no wall and no disk: the tallies are
-        those of now."""
+        those of now, but for the energy the drag gave."""
         if not self._flies_with_forces(particles, vessel, field):
             return 0
         flight = typing.cast(_SmoothFlight, self._flight)
-        flown = self._intervals(flight, particles, field, origin, elapsed, dt, record.values)
+        flown = self._intervals(flight, particles, field, origin, elapsed, dt, tally,
+                                record.values, record.forces)  # fmt: skip
         record.tally_of_now(flown, tally)
         # The interval left meets a contact (or too many substeps, or a value not finite):
         # `step` takes it next, and need not try it again.
@@ -382,11 +385,16 @@ class AdaptiveLeapfrog(Integrator):
         return flown
 
     def _intervals(self, flight: _SmoothFlight, particles: Particles, field: ForceField,
-                   origin: float, elapsed: int, dt: float, record: FloatArray) -> int:  # fmt: skip
-        """`_SmoothFlight.intervals` from the substep count kept, which it updates."""
+                   origin: float, elapsed: int, dt: float, tally: Tally, record: FloatArray,
+                   heat: FloatArray) -> int:  # fmt: skip
+        """`_SmoothFlight.intervals` from the substep count kept, which it updates, and the
+        energy the drag gave, which it adds to the ``tally``."""
         flown, self.substeps = flight.intervals(
-            particles, field, origin, elapsed, dt, self.substeps, self.tolerance, record
-        )
+            particles, field, origin, elapsed, dt, self.substeps, self.tolerance,
+            float(tally.forces[0]), record, heat,
+        )  # fmt: skip
+        if flown:
+            tally.forces[0] = heat[flown - 1]
         return flown
 
     def _interval(
@@ -416,7 +424,10 @@ class AdaptiveLeapfrog(Integrator):
         s = 1
         while s <= n:
             if flight is not None:  # as many substeps as meet no contact, compiled
-                s, t, fastest = flight.substeps(particles, field, now, dt, s, n, t, fastest, total)
+                now_total = total + (_given(tally) - given)
+                s, t, fastest, drag = flight.substeps(particles, field, now, dt, s, n, t, fastest,
+                                                      now_total)  # fmt: skip
+                tally.forces[0] += drag
                 if s > n:
                     break
             end = now + dt * s / n
@@ -586,6 +597,14 @@ def _newton(
     return s if math.isfinite(s) else math.nan
 
 
+#: The forces as the compiled substeps' arguments: the pair force's sources, coupling and squared
+#: softening, the uniform field's forces and carried fall, the magnetic field's frequencies and
+#: region, the drag's rates (`_SmoothFlight`).
+_ForceArguments = tuple[
+    FloatArray, float, float, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray
+]
+
+
 @dataclass(frozen=True, eq=False)
 class _SmoothFlight:
     """A scene's part in the compiled contact-free substeps (`collidium.kernels.substeps`): the
@@ -638,10 +657,11 @@ class _SmoothFlight:
         )
 
     @property
-    def _forces(self) -> tuple[FloatArray, float, float, FloatArray, FloatArray, FloatArray]:
+    def _forces(self) -> _ForceArguments:
         """The forces' arguments of the compiled substeps."""
         f = self.forces
-        return self.source, f.coupling, f.softening2, f.uniform, f.turn, f.region
+        return (self.source, f.coupling, f.softening2, f.uniform, f.fall, f.turn, f.region,
+                f.damp)  # fmt: skip
 
     def intervals(
         self,
@@ -652,22 +672,25 @@ class _SmoothFlight:
         dt: float,
         starting: int,
         tolerance: float,
+        given: float,
         record: FloatArray,
+        heat: FloatArray,
     ) -> tuple[int, int]:
         """Whole intervals, up to ``len(record)``, that meet no contact, the first taken with
         ``starting`` substeps or more (`collidium.kernels.substeps.smooth_intervals`):
-        ``(intervals taken, the substep count the next starts from)``. The field's acceleration
-        is kept current."""
+        ``(intervals taken, the substep count the next starts from)``; ``heat`` gets the energy
+        the velocity forces have given at each one's end, from ``given`` J before the first.
+        The field's acceleration is kept current."""
         flown, after = substeps.smooth_intervals(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
-            *self._forces, *self.walls, origin, elapsed, dt,
-            record.shape[0], starting, tolerance, MAX_SUBSTEPS, TOTAL_ENERGY_FLOOR, record,
+            *self._forces, *self.walls, origin, elapsed, dt, record.shape[0], starting,
+            tolerance, MAX_SUBSTEPS, TOTAL_ENERGY_FLOOR, given, record, heat,
         )  # fmt: skip
         return int(flown), int(after)
 
     def squared_rate(self, particles: Particles, field: ForceField, total: float) -> float:
         """`_squared_rate` of the current state, compiled (the same to round-off)."""
-        _, _, rate2 = self.substeps(particles, field, 0.0, 0.0, 1, 0, 0.0, -1.0, total)
+        _, _, rate2, _ = self.substeps(particles, field, 0.0, 0.0, 1, 0, 0.0, -1.0, total)
         return rate2
 
     def substeps(
@@ -681,11 +704,12 @@ class _SmoothFlight:
         t: float,
         fastest: float,
         total: float,
-    ) -> tuple[int, float, float]:
+    ) -> tuple[int, float, float, float]:
         """Regular substeps from ``first`` of ``count`` up to the first that may meet a
         contact (`collidium.kernels.substeps.smooth_substeps`, given the ``total`` energy J):
-        ``(that substep, its start in s, the largest squared rate)``. The field's acceleration
-        is kept current; its energies are summed again when read."""
+        ``(that substep, its start in s, the largest squared rate, the energy the drag gave in
+        J)``. The field's acceleration is kept current; its energies are summed again when
+        read."""
         return substeps.smooth_substeps(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
             *self._forces, *self.walls, now, dt, first, count, t,
@@ -693,8 +717,10 @@ class _SmoothFlight:
         )  # fmt: skip
 
 
-#: The record of a single compiled interval, not read (`AdaptiveLeapfrog._with_forces`).
+#: The record of a single compiled interval, not read, and the energy given by its end
+#: (`AdaptiveLeapfrog._with_forces`).
 _ONE = np.empty((1, len(substeps.RECORD)))
+_ONE_HEAT = np.empty(1)
 
 
 class _Snapshot:

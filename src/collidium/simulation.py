@@ -516,7 +516,7 @@ class Simulation:
                 kinetic, potential, virial, px, py, speed = record.values[rows][at].T
                 flown = Flown(times[rows][at], kinetic, potential, virial, px, py, speed,
                               record.counts[rows][at], record.impulse[rows][at],
-                              record.heat[rows][at])  # fmt: skip
+                              record.heat[rows][at], record.forces[rows][at])  # fmt: skip
                 take = getattr(observer, "take_flown")  # noqa: B009 (not in the protocol)
                 take(self, flown)
 

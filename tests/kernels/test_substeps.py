@@ -21,8 +21,10 @@ from collidium.kernels.vessels import BOX, CIRCLE, POLYGON
 
 FLOOR = 10.0
 NONE = np.empty((0, 9))
-#: No uniform field and no magnetic field (`smooth_substeps`'s ``uniform, turn, region``).
-FREE = (np.empty((0, 2)), np.empty(0), np.array([-np.inf, -np.inf, np.inf, np.inf]))
+WHOLE = np.array([-np.inf, -np.inf, np.inf, np.inf])
+#: No uniform field and no velocity force (`smooth_substeps`'s ``uniform, fall, turn, region,
+#: damp``).
+FREE = (np.empty((0, 2)), np.empty(0), np.empty(0), WHOLE, np.empty(0))
 HEXAGON = Polygon([[6.0 * np.cos(a), 6.0 * np.sin(a)] for a in np.arange(6) * np.pi / 3])
 
 
@@ -67,7 +69,7 @@ def test_substeps_equal_their_twin(rng, vessel, speed):
     total = kinetic_energy(mass, velocity) + energy(position, source, coupling, softening2)
     got = [a.copy() for a in (position, velocity, acceleration)]
     want = [a.copy() for a in (position, velocity, acceleration)]
-    step, t, fastest = smooth_substeps(*got, mass, radius, source, coupling, softening2, *FREE,
+    step, t, fastest, _ = smooth_substeps(*got, mass, radius, source, coupling, softening2, *FREE,
                                        shape, half[0], half[1], rim, table, 1.0, 0.1, 1, 16, 1.0,
                                        0.0, total, FLOOR)  # fmt: skip
     twin = reference.smooth_substeps(*want, mass, radius, source, coupling, softening2, *FREE,
@@ -81,40 +83,59 @@ def test_substeps_equal_their_twin(rng, vessel, speed):
         np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-12)
 
 
-def fields(position, mass, charge):
-    """A uniform field E = (0.3, -0.8) N/C and a magnetic field of 2 T in the left half of a
-    box (x < 0): the fields' forces, cyclotron frequencies and region."""
-    uniform = charge[:, None] * np.array([0.3, -0.8])
-    return uniform, 2.0 * charge / mass, np.array([-np.inf, -np.inf, 0.0, np.inf])
+def fields(mass, charge, kind):
+    """The fields of a box, as `smooth_substeps` takes them (``uniform, fall, turn, region,
+    damp``): an ``"electric"`` field E = (0.3, -0.8) N/C with a magnetic field of 2 T in the
+    left half of the box (x < 0); or a ``"falling"`` gravity g = (0, -3) m/s^2 that the drift
+    carries, with a linear drag of gamma = 0.7 kg/s."""
+    if kind == "electric":
+        uniform = charge[:, None] * np.array([0.3, -0.8])
+        left = np.array([-np.inf, -np.inf, 0.0, np.inf])
+        return uniform, np.empty(0), 2.0 * charge / mass, left, np.empty(0)
+    g = np.array([0.0, -3.0])
+    return mass[:, None] * g, g, np.empty(0), WHOLE, 0.7 / mass
 
 
+def pulled(position, mass, source, coupling, softening2, external):
+    """The accelerations and the total energy of a scene under ``external`` fields (`fields`):
+    the uniform field in the accelerations unless the drift carries it."""
+    uniform, fall = external[:2]
+    acceleration = accelerations(position, mass, source, coupling, softening2)
+    if not fall.size:
+        acceleration = acceleration + uniform / mass[:, None]
+    return acceleration, energy(position, source, coupling, softening2) - np.sum(position * uniform)
+
+
+@pytest.mark.parametrize("kind", ["electric", "falling"])
 @pytest.mark.parametrize("pair", [True, False])
-def test_substeps_under_uniform_and_magnetic_fields_equal_their_twin(rng, pair):
+def test_substeps_under_fields_equal_their_twin(rng, pair, kind):
     """Charges with (or without) their Coulomb pairs under a uniform electric field and a
-    magnetic field over half the box: the same substeps as the twin's, the motion and the rate
-    (the cyclotron frequency's square where it is the larger) to round-off; the turn keeps each
-    speed where it alone acts."""
+    magnetic field over half the box, or under a carried gravity and drag: the same substeps as
+    the twin's; the motion, the rate (the velocity forces' fastest rate squared where it is the
+    larger) and the energy the drag took, to round-off."""
     position, velocity, mass, radius, charge, coupling, softening2 = scene(rng, 12, speed=2.0)
-    uniform, turn, region = fields(position, mass, charge)
+    external = fields(mass, charge, kind)
     source = charge if pair else np.zeros_like(charge)
-    acceleration = (accelerations(position, mass, source, coupling, softening2)
-                    + uniform / mass[:, None])  # fmt: skip
-    total = kinetic_energy(mass, velocity) + energy(position, source, coupling, softening2)
-    total -= float(np.sum(position * uniform))
+    acceleration, potential = pulled(position, mass, source, coupling, softening2, external)
+    total = kinetic_energy(mass, velocity) + potential
     got = [a.copy() for a in (position, velocity, acceleration)]
     want = [a.copy() for a in (position, velocity, acceleration)]
     shape, half, rim, table = WALLS["box"]
-    step, t, fastest = smooth_substeps(*got, mass, radius, source, coupling, softening2, uniform,
-                                       turn, region, shape, half[0], half[1], rim, table, 1.0,
-                                       0.5, 1, 32, 1.0, 0.0, total, FLOOR)  # fmt: skip
-    twin = reference.smooth_substeps(*want, mass, radius, source, coupling, softening2, uniform,
-                                     turn, region, shape, half, rim, table, 1.0, 0.5, 1, 32, 1.0,
+    step, t, fastest, given = smooth_substeps(*got, mass, radius, source, coupling, softening2,
+                                              *external, shape, half[0], half[1], rim, table,
+                                              1.0, 0.5, 1, 32, 1.0, 0.0, total,
+                                              FLOOR)  # fmt: skip
+    twin = reference.smooth_substeps(*want, mass, radius, source, coupling, softening2,
+                                     *external, shape, half, rim, table, 1.0, 0.5, 1, 32, 1.0,
                                      0.0, total, FLOOR, CONTACT_MARGIN)  # fmt: skip
     assert (step, t) == twin[:2]
     assert step > 4  # some substeps taken before a contact, if any
     np.testing.assert_allclose(fastest, twin[2], rtol=1e-12)
     if not pair:
-        assert fastest == np.max(np.abs(turn)) ** 2
+        rates = external[2] if kind == "electric" else external[4]
+        assert fastest == np.max(np.abs(rates)) ** 2
+    np.testing.assert_allclose(given, twin[3], rtol=1e-12)
+    assert (given < 0.0) == (kind == "falling")
     for ours, theirs in zip(got, want, strict=True):
         np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-12)
 
@@ -126,17 +147,35 @@ def test_a_magnetic_field_turns_a_charge_without_changing_its_speed():
     position = np.array([[0.0, -1.0]])
     velocity = np.array([[1.0, 0.0]])
     mass = np.ones(1)
-    whole = np.array([-np.inf, -np.inf, np.inf, np.inf])
     omega = 1.0  # q B / m: clockwise, on the circle of radius 1 about (0, -2)
     args = (np.zeros((1, 2)), mass, np.full(1, 0.1), np.zeros(1), 0.0, 0.0, np.empty((0, 2)),
-            np.full(1, omega), whole, BOX, 5.0, 5.0, np.nan, NONE, 0.0, np.pi, 1, 256, 0.0,
-            0.0, 0.5, FLOOR)  # fmt: skip
-    step, t, fastest = smooth_substeps(position, velocity, *args)
-    assert (step, fastest) == (257, omega**2)
+            np.empty(0), np.full(1, omega), WHOLE, np.empty(0), BOX, 5.0, 5.0, np.nan, NONE,
+            0.0, np.pi, 1, 256, 0.0, 0.0, 0.5, FLOOR)  # fmt: skip
+    step, t, fastest, given = smooth_substeps(position, velocity, *args)
+    assert (step, fastest, given) == (257, omega**2, 0.0)
     assert t == pytest.approx(np.pi, rel=1e-15)
     np.testing.assert_allclose(velocity[0], [-1.0, 0.0], atol=(np.pi / 256) ** 2)
     assert np.hypot(*velocity[0]) == pytest.approx(1.0, rel=1e-14)
     np.testing.assert_allclose(position[0], [0.0, -3.0], atol=(np.pi / 256) ** 2)
+
+
+def test_a_disk_falling_through_a_fluid_reaches_its_terminal_velocity():
+    """A disk of 2 kg dropped from rest under g = 1 m/s^2 with linear drag gamma = 1 kg/s: its
+    velocity after 6 time constants is ``-m g / gamma (1 - exp(-6))`` to O(h^2), and the
+    energy the drag took is what the fall gave less what the disk keeps."""
+    position, velocity = np.array([[0.0, 15.0]]), np.zeros((1, 2))
+    mass, g = np.array([2.0]), np.array([0.0, -1.0])
+    h = 12.0 / 1024
+    args = (np.zeros((1, 2)), mass, np.full(1, 0.1), np.zeros(1), 0.0, 0.0, mass[:, None] * g,
+            g, np.empty(0), WHOLE, 1.0 / mass, BOX, 5.0, 50.0, np.nan, NONE, 0.0, 12.0, 1,
+            1024, 0.0, 0.0, 1.0, FLOOR)  # fmt: skip
+    step, _, fastest, given = smooth_substeps(position, velocity, *args)
+    assert (step, fastest) == (1025, 0.25)
+    terminal = -2.0 * (1.0 - np.exp(-6.0))
+    np.testing.assert_allclose(velocity[0], [0.0, terminal], atol=h**2)
+    fallen = 15.0 - position[0, 1]
+    kept = 0.5 * 2.0 * velocity[0, 1] ** 2
+    assert given == pytest.approx(kept - 2.0 * 1.0 * fallen, rel=1e-12)
 
 
 def test_a_crowd_stops_where_its_all_pairs_twin_stops(rng):
@@ -153,7 +192,7 @@ def test_a_crowd_stops_where_its_all_pairs_twin_stops(rng):
         velocity = rng.normal(0.0, 1.0, (n, 2))
         args = (np.zeros((n, 2)), np.ones(n), radius, np.zeros(n), 5.0, 0.0, *FREE, BOX)
         got, want = (position.copy(), velocity.copy()), (position.copy(), velocity.copy())
-        step, t, _ = smooth_substeps(*got, *args, 20.0, 20.0, np.nan, NONE, 0.0, 2.0, 1, 64, 0.0,
+        step, t, _, _ = smooth_substeps(*got, *args, 20.0, 20.0, np.nan, NONE, 0.0, 2.0, 1, 64, 0.0,
                                      0.0, 1.0, FLOOR)  # fmt: skip
         twin = reference.smooth_substeps(*want, *args, np.array([20.0, 20.0]), np.nan, NONE, 0.0,
                                          2.0, 1, 64, 0.0, 0.0, 1.0, FLOOR,
@@ -172,9 +211,9 @@ def test_a_disk_bound_for_a_wall_stops_the_substeps_just_before_it():
     velocity = np.array([[10.0, 0.0], [0.0, 0.0]])
     acceleration = np.zeros((2, 2))
     mass, radius = np.ones(2), np.array([0.1, 0.1])
-    step, t, _ = smooth_substeps(position, velocity, acceleration, mass, radius, np.zeros(2), 5.0,
-                                 0.0, *FREE, BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.16, 1, 16, 0.0,
-                                 0.0, 50.0, FLOOR)  # fmt: skip
+    step, t, _, _ = smooth_substeps(position, velocity, acceleration, mass, radius, np.zeros(2),
+                                    5.0, 0.0, *FREE, BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.16, 1,
+                                    16, 0.0, 0.0, 50.0, FLOOR)  # fmt: skip
     # The wall's contact is at x = 4.9, 0.1 s on: substeps 1 to 9 end at 0.09 s.
     assert (step, t) == (10, pytest.approx(0.09, rel=1e-15))
     np.testing.assert_allclose(position[0], [3.9 + 0.9, 0.0], rtol=1e-14)
@@ -190,7 +229,7 @@ def test_a_grazing_pair_stops_the_substeps_within_the_margin(miss):
     velocity = np.array([[5.0, 0.0], [-5.0, 0.0]])
     args = (np.zeros((2, 2)), np.ones(2), np.full(2, 0.5 * sigma), np.zeros(2), 5.0, 0.0, *FREE,
             BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0.4, 1, 4, 0.0, 0.0, 25.0, FLOOR)  # fmt: skip
-    step, _, _ = smooth_substeps(position, velocity, *args)
+    step, _, _, _ = smooth_substeps(position, velocity, *args)
     assert step == (5 if miss > CONTACT_MARGIN else 2)  # they meet in the second 0.1 s
 
 
@@ -201,7 +240,7 @@ def test_infinite_accelerations_stop_the_substeps_with_nothing_changed():
     velocity = np.zeros((2, 2))
     acceleration = np.zeros((2, 2))
     before = position.copy()
-    step, t, fastest = smooth_substeps(position, velocity, acceleration, np.array([1e-310, 1.0]),
+    step, t, fastest, _ = smooth_substeps(position, velocity, acceleration, np.array([1e-310, 1.0]),
                                        np.zeros(2), np.ones(2), 5.0, 0.0, *FREE, BOX, 5.0, 5.0,
                                        np.nan, NONE, 0.0, 0.1, 1, 4, 0.0, 0.0, 2.5,
                                        FLOOR)  # fmt: skip
@@ -243,35 +282,40 @@ def test_intervals_equal_their_twin(count):
     record = np.empty((count, len(RECORD)))
     flown, after = smooth_intervals(*got, mass, radius, charge, 5.0, 0.0, *FREE, BOX, 5.0, 5.0,
                                     np.nan, NONE, 0.0, 0, 0.05, count, 1, TOLERANCE, MOST, FLOOR,
-                                    record)  # fmt: skip
+                                    0.0, record, np.empty(count))  # fmt: skip
     twin = reference.smooth_intervals(*want, mass, radius, charge, 5.0, 0.0, *FREE, BOX,
                                       np.array([5.0, 5.0]), np.nan, NONE, 0.0, 0, 0.05, count, 1,
-                                      TOLERANCE, MOST, FLOOR, CONTACT_MARGIN)  # fmt: skip
+                                      TOLERANCE, MOST, FLOOR, 0.0, CONTACT_MARGIN)  # fmt: skip
     assert (flown, after) == (count, twin[1]) and twin[0] == count
     assert after >= 8  # the inner orbit needs substeps
-    np.testing.assert_allclose(record, twin[2], rtol=1e-11, atol=1e-12)
+    np.testing.assert_allclose(record, twin[2][:, :-1], rtol=1e-11, atol=1e-12)
     for ours, theirs in zip(got, want, strict=True):
         np.testing.assert_allclose(ours, theirs, rtol=1e-10, atol=1e-12)
 
 
-def test_intervals_under_fields_equal_their_twin():
-    """The three bodies under a uniform electric field and a magnetic field over half the box:
-    the record's potential has the field's ``-F . x`` too, as the twin's."""
+@pytest.mark.parametrize("kind", ["electric", "falling"])
+def test_intervals_under_fields_equal_their_twin(kind):
+    """The three bodies under a uniform electric field and a magnetic field over half the box,
+    or under a carried gravity and drag: the record's potential has the field's ``-F . x``
+    too, and the energy the drag has given is kept interval by interval, as the twin's."""
     position, velocity, mass, radius, charge = three_bodies()
-    uniform, turn, region = fields(position, mass, charge)
-    acceleration = accelerations(position, mass, charge, 5.0, 0.0) + uniform / mass[:, None]
+    external = fields(mass, charge, kind)
+    acceleration, _ = pulled(position, mass, charge, 5.0, 0.0, external)
     got = [a.copy() for a in (position, velocity, acceleration)]
     want = [a.copy() for a in (position, velocity, acceleration)]
-    record = np.empty((20, len(RECORD)))
-    flown, after = smooth_intervals(*got, mass, radius, charge, 5.0, 0.0, uniform, turn, region,
-                                    BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0, 0.05, 20, 1, TOLERANCE,
-                                    MOST, FLOOR, record)  # fmt: skip
-    twin = reference.smooth_intervals(*want, mass, radius, charge, 5.0, 0.0, uniform, turn,
-                                      region, BOX, np.array([5.0, 5.0]), np.nan, NONE, 0.0, 0,
-                                      0.05, 20, 1, TOLERANCE, MOST, FLOOR,
-                                      CONTACT_MARGIN)  # fmt: skip
+    record, heat = np.empty((20, len(RECORD))), np.empty(20)
+    flown, after = smooth_intervals(*got, mass, radius, charge, 5.0, 0.0, *external, BOX, 5.0,
+                                    5.0, np.nan, NONE, 0.0, 0, 0.05, 20, 1, TOLERANCE, MOST,
+                                    FLOOR, 1.5, record, heat)  # fmt: skip
+    twin = reference.smooth_intervals(*want, mass, radius, charge, 5.0, 0.0, *external, BOX,
+                                      np.array([5.0, 5.0]), np.nan, NONE, 0.0, 0, 0.05, 20, 1,
+                                      TOLERANCE, MOST, FLOOR, 1.5, CONTACT_MARGIN)  # fmt: skip
     assert (flown, after) == twin[:2] and flown >= 10
-    np.testing.assert_allclose(record[:flown], twin[2], rtol=1e-11, atol=1e-12)
+    np.testing.assert_allclose(record[:flown], twin[2][:, :-1], rtol=1e-11, atol=1e-12)
+    # The drag's energy ``m v^2 (f^2 - 1) / 2`` magnifies an ulp of ``f = exp(-gamma h / m)``
+    # (NumPy's and numba's differ) by ``m / (2 gamma h)``, about 200 here: as the motion.
+    np.testing.assert_allclose(heat[:flown], twin[2][:, -1], rtol=1e-10)
+    assert (heat[flown - 1] < 1.5) == (kind == "falling")
     for ours, theirs in zip(got, want, strict=True):
         np.testing.assert_allclose(ours, theirs, rtol=1e-10, atol=1e-12)
 
@@ -287,12 +331,12 @@ def test_an_interval_that_meets_a_wall_is_left_as_it_began():
     record = np.empty((10, len(RECORD)))
     flown, after = smooth_intervals(*state, mass, radius, charge, 5.0, 0.0, *FREE, BOX, 5.0,
                                     5.0, np.nan, NONE, 0.0, 0, 0.05, 10, 1, TOLERANCE, MOST,
-                                    FLOOR, record)  # fmt: skip
+                                    FLOOR, 0.0, record, np.empty(10))  # fmt: skip
     assert 1 <= flown <= 3
     before = [a.copy() for a in (position, velocity, acceleration)]
     _, want = smooth_intervals(*before, mass, radius, charge, 5.0, 0.0, *FREE, BOX, 5.0, 5.0,
                                np.nan, NONE, 0.0, 0, 0.05, flown, 1, TOLERANCE, MOST, FLOOR,
-                               record)  # fmt: skip
+                               0.0, record, np.empty(10))  # fmt: skip
     assert after == want
     for ours, theirs in zip(state, before, strict=True):
         np.testing.assert_array_equal(ours, theirs)
@@ -305,7 +349,8 @@ def test_intervals_that_need_too_many_substeps_are_left_to_the_integrator():
     state = [position, np.zeros((2, 2)), np.zeros((2, 2))]
     flown, after = smooth_intervals(*state, np.ones(2), np.zeros(2), np.array([1.0, -1.0]), 5.0,
                                     0.0, *FREE, BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0, 1.0, 4, 2,
-                                    1e-4, 16, FLOOR, np.empty((4, len(RECORD))))  # fmt: skip
+                                    1e-4, 16, FLOOR, 0.0, np.empty((4, len(RECORD))),
+                                    np.empty(4))  # fmt: skip
     assert (flown, after) == (0, 2)
     np.testing.assert_array_equal(state[0], [[0.0, 0.0], [0.001, 0.0]])
 

@@ -129,6 +129,16 @@ class TurningForce(VelocityForce, Protocol):
         """Where the force acts: ``(left, bottom, right, top)`` in m, infinite for the plane."""
 
 
+@runtime_checkable
+class DampingForce(VelocityForce, Protocol):
+    """A velocity force that damps each velocity at a constant rate (linear drag), which the
+    compiled substeps can apply (`collidium.kernels.substeps`)."""
+
+    def damping(self, particles: Particles) -> FloatArray:
+        """Each particle's rate of damping (N,), 1/s: a velocity falls by ``exp(-rate h)`` in
+        ``h`` seconds."""
+
+
 #: Every force by its name (filled as the force modules are imported).
 FORCES: dict[str, type[Force]] = {}
 
@@ -246,45 +256,64 @@ class CompiledForces:
         without one.
     uniform : ndarray, shape (N, 2) or (0, 2)
         The uniform field's force on each particle, N (none: empty).
+    fall : ndarray, shape (2,) or (0,)
+        The acceleration of the uniform field where the drift carries it (a gravity), m/s^2:
+        the compiled substeps then kick with it, and it is not in the field's accelerations;
+        empty where the field (if any) is in them.
     turn : ndarray, shape (N,) or (0,)
         The magnetic field's signed cyclotron frequencies, rad/s (none: empty).
     region : ndarray, shape (4,)
         Where the magnetic field acts: left, bottom, right, top, m.
+    damp : ndarray, shape (N,) or (0,)
+        The drag's damping rates, 1/s (none: empty).
     """
 
     source: str | None
     coupling: float
     softening2: float
     uniform: FloatArray
+    fall: FloatArray
     turn: FloatArray
     region: FloatArray
+    damp: FloatArray
 
 
 _WHOLE_PLANE = np.array([-np.inf, -np.inf, np.inf, np.inf])
 
-_Parts = tuple[DirectPairForce | None, UniformPositionForce | None, TurningForce | None]
 
+@dataclasses.dataclass(frozen=True)
+class _CompiledParts:
+    """The forces by the part the compiled substeps give them, each None if absent, and whether
+    the drift carries the uniform field."""
 
-def _compiled_parts(
-    position: tuple[PositionForce, ...],
-    velocity: tuple[VelocityForce, ...],
-    carried: tuple[bool, ...],
-) -> _Parts | None:
-    """The forces as ``(pair sum, uniform field, magnetic field)``, each None if absent, or None
-    if there is more than one of a kind, a force of another kind, a force the drift carries, or
-    no force at all (`ForceField.compiled`)."""
-    pairs = [f for f in position if isinstance(f, DirectPairForce)]
-    uniform = [f for f in position if isinstance(f, UniformPositionForce)]
-    turning = [f for f in velocity if isinstance(f, TurningForce)]
-    if (
-        any(carried)
-        or len(pairs) + len(uniform) != len(position)
-        or len(turning) != len(velocity)
-        or max(len(pairs), len(uniform), len(turning)) > 1
-        or not (position or velocity)
-    ):
-        return None
-    return _one(pairs), _one(uniform), _one(turning)
+    pair: DirectPairForce | None
+    uniform: UniformPositionForce | None
+    carried: bool
+    turning: TurningForce | None
+    damping: DampingForce | None
+
+    @classmethod
+    def of(
+        cls,
+        position: tuple[PositionForce, ...],
+        velocity: tuple[VelocityForce, ...],
+        carried: tuple[bool, ...],
+    ) -> _CompiledParts | None:
+        """The parts of the forces, or None if there is more than one of a kind, a force of
+        another kind or no force at all (`ForceField.compiled`)."""
+        pairs = [f for f in position if isinstance(f, DirectPairForce)]
+        uniform = [f for f in position if isinstance(f, UniformPositionForce)]
+        turning = [f for f in velocity if isinstance(f, TurningForce)]
+        damping = [f for f in velocity if isinstance(f, DampingForce)]
+        kinds = (pairs, uniform, turning, damping)
+        if (
+            sum(len(kind) for kind in kinds) != len(position) + len(velocity)
+            or max(len(kind) for kind in kinds) > 1
+            or not (position or velocity)
+        ):
+            return None
+        carries = any(carried)  # only a uniform field (a gravity) can be carried
+        return cls(_one(pairs), _one(uniform), carries, _one(turning), _one(damping))
 
 
 _Kind = TypeVar("_Kind")
@@ -344,7 +373,7 @@ class ForceField:
         self._carried = tuple(carry_fall and f.fall is not None for f in self._position)
         #: The forces by the part the compiled substeps give them (`compiled`; a protocol
         #: check is slow), or None where a force is none of those parts.
-        self._compiled = _compiled_parts(self._position, self._velocity, self._carried)
+        self._compiled = _CompiledParts.of(self._position, self._velocity, self._carried)
         self._fall = np.zeros(2)
         for force, carried in zip(self._position, self._carried, strict=True):
             if carried:
@@ -432,26 +461,29 @@ class ForceField:
     def compiled(self, particles: Particles, vessel: Vessel) -> CompiledForces | None:
         """The forces as the compiled substeps take them (`collidium.kernels.substeps`), or
         None unless they are at most one direct inverse-distance pair sum
-        (`DirectPairForce.direct_term`), one uniform field that the drift does not carry
-        (`UniformPositionForce`) and one magnetic field (`TurningForce`), and at least one of
-        them."""
-        if self._compiled is None:
+        (`DirectPairForce.direct_term`), one uniform field (`UniformPositionForce`, carried by
+        the drift or not), one magnetic field (`TurningForce`) and one linear drag
+        (`DampingForce`), and at least one of them."""
+        parts = self._compiled
+        if parts is None:
             return None
-        pair, uniform, turning = self._compiled
         term = ("charge", 0.0, 0.0)  # no pair force: its sources are all 0
-        if pair is not None:
-            found = pair.direct_term(particles, vessel)
+        if parts.pair is not None:
+            found = parts.pair.direct_term(particles, vessel)
             if found is None:
                 return None
             term = found
         name, coupling, softening2 = term
+        uniform, turning, damping = parts.uniform, parts.turning, parts.damping
         return CompiledForces(
-            name if pair is not None else None,
+            name if parts.pair is not None else None,
             coupling,
             softening2,
             np.empty((0, 2)) if uniform is None else uniform.uniform_force(particles),
+            self._fall.copy() if parts.carried else np.empty(0),
             np.empty(0) if turning is None else turning.cyclotron(particles),
             _WHOLE_PLANE if turning is None else turning.bounds(),
+            np.empty(0) if damping is None else damping.damping(particles),
         )
 
     def stiffness(self, particles: Particles, vessel: Vessel) -> float:

@@ -49,6 +49,10 @@ class LinearDrag:
         """``gamma / m`` of the lightest particle, 1/s."""
         return damping_rate(self.gamma, particles)
 
+    def damping(self, particles: Particles) -> np.ndarray:
+        """Each particle's ``gamma / m`` (N,), 1/s (`collidium.forces.base.DampingForce`)."""
+        return np.asarray(self.gamma / particles.mass)
+
     def to_dict(self) -> dict[str, object]:
         """Parameters as in a scenario file."""
         return {"type": self.name, "gamma": self.gamma}

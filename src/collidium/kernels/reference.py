@@ -848,8 +848,10 @@ def smooth_substeps(
     coupling: float,
     softening2: float,
     uniform: FloatArray,
+    fall: FloatArray,
     turn: FloatArray,
     region: FloatArray,
+    damp: FloatArray,
     shape: int,
     half: FloatArray,
     rim: float,
@@ -863,24 +865,28 @@ def smooth_substeps(
     total: float,
     energy_floor: float,
     margin: float,
-) -> tuple[int, float, float]:
+) -> tuple[int, float, float, float]:
     """Twin of `substeps.smooth_substeps` in a box of half sides ``half`` (``shape`` `BOX`), a
     circle of radius ``rim`` (`CIRCLE`) or neither, and against the segments of ``table``.
 
-    Each substep: the magnetic turn (`turned`) and the kick; the contact test on all pairs and
-    walls at once (contacts within ``margin`` of a radius, or of the substep); the straight
-    flight; the force (`inverse_distance_direct` and the ``uniform`` field's); the kick and
-    the turn; the squared rate from the ``total`` energy (`squared_rate`). Updates the motion
-    in place and returns ``(substep not taken, its start, fastest)``.
+    Each substep: the velocity forces' flow (`flowed`) and the kick (with the carried
+    ``fall``, if any); the contact test on all pairs and walls at once (contacts within
+    ``margin`` of a radius, or of the substep); the straight flight; the force
+    (`inverse_distance_direct` and the ``uniform`` field's, unless carried); the kick and the
+    flow; the squared rate from the ``total`` energy (`squared_rate`). Updates the motion in
+    place and returns ``(substep not taken, its start, fastest, energy the drag gave)``.
     """
     zero = np.zeros(2)
+    given = 0.0
+    carried = fall if fall.size else zero
     if fastest < 0.0:
         fastest = squared_rate(position, velocity, mass, source, coupling, softening2, turn,
-                               total, energy_floor)  # fmt: skip
+                               damp, total, energy_floor)  # fmt: skip
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
-        kicked = turned(position, velocity, turn, region, 0.5 * h) + 0.5 * h * acceleration
+        flowed_in, before = flowed(position, velocity, mass, turn, region, damp, 0.5 * h)
+        kicked = flowed_in + 0.5 * h * (acceleration + carried)
         wide = radius * (1.0 + margin)
         wall = math.inf
         if shape == CIRCLE:
@@ -897,35 +903,47 @@ def smooth_substeps(
         sigma = (radius[:, None] + radius[None, :]) * (1.0 + margin)
         meets = (np.einsum("ijk,ijk->ij", closest, closest) <= sigma**2) & (sigma > 0)
         if not np.isfinite(kicked).all() or wall <= h * (1.0 + margin) or np.triu(meets, 1).any():
-            return s, t, fastest
+            return s, t, fastest, given
         flown = position + kicked * h
         force = inverse_distance_direct(flown, source, coupling, softening2)[0]
-        pull = (force + uniform if uniform.size else force) / mass[:, None]
+        pull = (force + uniform if uniform.size and not fall.size else force) / mass[:, None]
         if not np.isfinite(pull).all():
-            return s, t, fastest
+            return s, t, fastest, given
         position[...] = flown
-        velocity[...] = turned(flown, kicked + 0.5 * h * pull, turn, region, 0.5 * h)
+        velocity[...], after = flowed(flown, kicked + 0.5 * h * (pull + carried), mass, turn,
+                                      region, damp, 0.5 * h)  # fmt: skip
         acceleration[...] = pull
+        given += before + after
         t = end
-        rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, turn, total,
-                             energy_floor)  # fmt: skip
+        rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, turn, damp,
+                             total + given, energy_floor)  # fmt: skip
         fastest = max(fastest, rate2)
-    return count + 1, t, fastest
+    return count + 1, t, fastest, given
 
 
-def turned(
-    position: FloatArray, velocity: FloatArray, turn: FloatArray, region: FloatArray, lag: float
-) -> FloatArray:
-    """Twin of the substeps' magnetic flow: the velocities (N, 2) of the particles inside
-    ``region`` (left, bottom, right, top) turned by ``-turn lag`` (a new array)."""
+def flowed(
+    position: FloatArray,
+    velocity: FloatArray,
+    mass: FloatArray,
+    turn: FloatArray,
+    region: FloatArray,
+    damp: FloatArray,
+    lag: float,
+) -> tuple[FloatArray, float]:
+    """Twin of the substeps' velocity flows: the velocities (N, 2) damped by ``exp(-damp lag)``
+    and, inside ``region`` (left, bottom, right, top), turned by ``-turn lag`` (a new array),
+    and the kinetic energy that gave (J)."""
+    factor = np.exp(-damp * lag) if damp.size else np.ones(len(velocity))
+    damped = velocity * factor[:, None]
+    given = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1) * (factor**2 - 1.0)))
     if turn.size == 0:
-        return velocity.copy()
+        return damped, given
     x, y = position[:, 0], position[:, 1]
     inside = (x >= region[0]) & (x <= region[2]) & (y >= region[1]) & (y <= region[3])
     angle = np.where(inside, -turn * lag, 0.0)
     cos, sin = np.cos(angle), np.sin(angle)
-    vx, vy = velocity[:, 0], velocity[:, 1]
-    return np.stack([cos * vx - sin * vy, sin * vx + cos * vy], axis=1)
+    vx, vy = damped[:, 0], damped[:, 1]
+    return np.stack([cos * vx - sin * vy, sin * vx + cos * vy], axis=1), given
 
 
 def squared_rate(
@@ -936,18 +954,20 @@ def squared_rate(
     coupling: float,
     softening2: float,
     turn: FloatArray,
+    damp: FloatArray,
     total: float,
     energy_floor: float,
 ) -> float:
     """Twin of the substeps' rate: the square root of the stiffness
     (`inverse_distance_stiffness`) over the energy scale, ``|E|`` (``total``) but at least
-    ``(KE + |U|) / energy_floor`` with ``U = E - KE``; or the fastest cyclotron frequency
-    ``turn`` squared, if larger."""
+    ``(KE + |U|) / energy_floor`` with ``U = E - KE``; or the fastest rate of the velocity
+    forces (cyclotron frequencies ``turn``, damping rates ``damp``) squared, if larger."""
     stiffness = inverse_distance_stiffness(position, velocity, source, mass, coupling, softening2)
     kinetic = 0.5 * float(np.sum(mass * np.sum(velocity**2, axis=1)))
     scale = max(abs(total), (kinetic + abs(total - kinetic)) / energy_floor)
     energy = math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
-    return max(energy, float(np.max(np.abs(turn), initial=0.0)) ** 2)
+    rates = np.concatenate([np.abs(turn), damp])
+    return max(energy, float(np.max(rates, initial=0.0)) ** 2)
 
 
 def needed(rate2: float, dt: float, tolerance: float, most: int) -> int:
@@ -969,8 +989,10 @@ def smooth_intervals(
     coupling: float,
     softening2: float,
     uniform: FloatArray,
+    fall: FloatArray,
     turn: FloatArray,
     region: FloatArray,
+    damp: FloatArray,
     shape: int,
     half: FloatArray,
     rim: float,
@@ -983,13 +1005,15 @@ def smooth_intervals(
     tolerance: float,
     most: int,
     energy_floor: float,
+    given: float,
     margin: float,
 ) -> tuple[int, int, FloatArray]:
     """Twin of `substeps.smooth_intervals`: interval by interval, the substep count from the
     rate at its start (`needed`), `smooth_substeps` from its first substep, taken again with
     more substeps while a boundary needs more; the first interval that meets a contact is put
     back as it began. Returns ``(intervals taken, the next count, the record of each: kinetic
-    and potential energy, pair virial, momentum x and y, total speed)``."""
+    and potential energy, pair virial, momentum x and y, total speed, the energy the drag has
+    given since ``given`` J before the first)``."""
     record: list[tuple[float, ...]] = []
 
     def energies() -> tuple[float, float, float]:
@@ -1001,22 +1025,22 @@ def smooth_intervals(
     def table_row() -> tuple[float, ...]:
         px, py = mass @ velocity
         speeds = float(np.sum(np.hypot(velocity[:, 0], velocity[:, 1])))
-        return (*energies(), float(px), float(py), speeds)
+        return (*energies(), float(px), float(py), speeds, given)
 
     for k in range(count):
         now = origin + (elapsed + k) * dt
         total = sum(energies()[:2])
-        rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, turn, total,
-                             energy_floor)  # fmt: skip
+        rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, turn, damp,
+                             total, energy_floor)  # fmt: skip
         if not dt * math.sqrt(rate2) <= most * tolerance:
-            return k, substeps, np.array(record).reshape(-1, 6)
+            return k, substeps, np.array(record).reshape(-1, 7)
         taken = max(substeps, needed(rate2, dt, tolerance, most))
         start = [a.copy() for a in (position, velocity, acceleration)]
         while True:
-            reached, _, fastest = smooth_substeps(
+            reached, _, fastest, drag = smooth_substeps(
                 position, velocity, acceleration, mass, radius, source, coupling, softening2,
-                uniform, turn, region, shape, half, rim, table, now, dt, 1, taken, now, rate2,
-                total, energy_floor, margin,
+                uniform, fall, turn, region, damp, shape, half, rim, table, now, dt, 1, taken,
+                now, rate2, total, energy_floor, margin,
             )  # fmt: skip
             met = reached <= taken
             required = needed(fastest, dt, tolerance, most)
@@ -1024,10 +1048,11 @@ def smooth_intervals(
                 for array, kept in zip((position, velocity, acceleration), start, strict=True):
                     array[...] = kept
             if met:
-                return k, substeps, np.array(record).reshape(-1, 6)
+                return k, substeps, np.array(record).reshape(-1, 7)
             if required <= taken:
                 break
             taken = max(required, 2 * taken)
         substeps = max(1, taken // 2) if required <= taken // 2 else taken
+        given += drag
         record.append(table_row())
-    return count, substeps, np.array(record).reshape(-1, 6)
+    return count, substeps, np.array(record).reshape(-1, 7)

@@ -53,19 +53,20 @@ def energy_scale(kinetic: float, total: float, floor: float) -> float:
 
 @numba.njit(cache=True, error_model="numpy")
 def smooth_substeps(
-    position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, turn,
-    region, shape, half_width, half_height, rim, segments, now, dt, first, count, t, fastest,
-    total, energy_floor,
-) -> tuple[int, float, float]:  # fmt: skip
+    position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, fall,
+    turn, region, damp, shape, half_width, half_height, rim, segments, now, dt, first, count, t,
+    fastest, total, energy_floor,
+) -> tuple[int, float, float, float]:  # fmt: skip
     """Regular substeps ``first, first + 1, ...`` of ``count`` in the interval from ``now`` of
     ``dt`` (s), in place, up to the first that may meet a contact.
 
-    Substep s ends at ``now + dt s / count``; it is the magnetic field's turn for ``h / 2``, a
-    kick ``v += a h / 2``, the straight flight over h, the accelerations at the new positions,
-    the kick ``v += a h / 2`` and the turn for ``h / 2``. After each, the squared rate of the
-    forces weighted by energy (`collidium.integrators._squared_rate`) raises ``fastest``. No
-    energy is summed: the rate's energy scale takes the potential as the ``total`` energy less
-    the kinetic (the forces conserve the total to the tolerance).
+    Substep s ends at ``now + dt s / count``; it is the velocity forces' flow for ``h / 2``
+    (`_flow`: the drag, the magnetic field's turn), a kick ``v += a h / 2``, the straight flight
+    over h, the accelerations at the new positions, the kick ``v += a h / 2`` and the flow for
+    ``h / 2``. After each, the squared rate of the forces weighted by energy
+    (`collidium.integrators._squared_rate`) raises ``fastest``. No energy is summed: the rate's
+    energy scale takes the potential as the total energy less the kinetic, the total as
+    ``total`` and what the drag gave since.
 
     Parameters
     ----------
@@ -79,11 +80,17 @@ def smooth_substeps(
         Its coupling (N m^2 per source squared) and squared softening (m^2).
     uniform : ndarray, shape (N, 2) or (0, 2)
         A uniform field's force on each particle, N; empty without one.
+    fall : ndarray, shape (2,) or (0,)
+        The uniform field's acceleration (m/s^2) where the drift carries it (a gravity): the
+        kicks add it, ``acceleration`` has it not, and ``uniform`` counts in the energies only.
+        Empty where ``uniform`` is in ``acceleration``.
     turn : ndarray, shape (N,) or (0,)
         A magnetic field's signed cyclotron frequency ``q B / m`` of each particle, rad/s
-        (`_turn`); empty without one.
+        (`_flow`); empty without one.
     region : ndarray, shape (4,)
         Where the magnetic field acts: left, bottom, right, top (m), infinite for the plane.
+    damp : ndarray, shape (N,) or (0,)
+        A linear drag's ``gamma / m`` of each particle, 1/s (`_flow`); empty without one.
     shape, half_width, half_height, rim, segments
         The vessel as the exact engine has it (`collidium.kernels.vessels.contacts.earliest`).
     now, dt : float
@@ -96,7 +103,7 @@ def smooth_substeps(
         Largest squared rate so far, 1/s^2; if negative, the rate of the state given (with
         ``first > count``, the call returns just that: the rate of an interval's start).
     total : float
-        The total energy (kinetic and potential) at the interval's start, J.
+        The total energy (kinetic and potential) at substep ``first``'s start, J.
     energy_floor : float
         The rate's energy scale is ``|KE + U|`` but at least ``(KE + |U|) / energy_floor``
         (`energy_scale`).
@@ -104,12 +111,13 @@ def smooth_substeps(
     Returns
     -------
     tuple
-        ``(substep, time, fastest)``: the substep not taken (``count + 1`` when all were), its
-        start (s) and the largest squared rate.
+        ``(substep, time, fastest, given)``: the substep not taken (``count + 1`` when all
+        were), its start (s), the largest squared rate and the energy the drag gave in the
+        substeps taken (J, negative).
     """
     work = _work(mass, source)
     walls = (shape, half_width, half_height, rim, segments)
-    external = (uniform, turn, region)
+    external = (uniform, fall, turn, region, damp)
     return _substeps(position, velocity, acceleration, mass, radius, coupling, softening2,
                      external, walls, now, dt, first, count, t, fastest, total, energy_floor,
                      work)  # fmt: skip
@@ -117,9 +125,9 @@ def smooth_substeps(
 
 @numba.njit(cache=True, error_model="numpy")
 def smooth_intervals(
-    position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, turn,
-    region, shape, half_width, half_height, rim, segments, origin, elapsed, dt, count,
-    substeps, tolerance, most_substeps, energy_floor, record,
+    position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, fall,
+    turn, region, damp, shape, half_width, half_height, rim, segments, origin, elapsed, dt,
+    count, substeps, tolerance, most_substeps, energy_floor, given, record, heat,
 ) -> tuple[int, int]:  # fmt: skip
     """Up to ``count`` whole reporting intervals of ``dt`` (s), in place, each as the adaptive
     integrator takes one (`collidium.integrators.AdaptiveLeapfrog`), up to the first that meets
@@ -133,8 +141,8 @@ def smooth_intervals(
 
     Parameters
     ----------
-    position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform,
-    turn, region, shape, half_width, half_height, rim, segments
+    position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, fall,
+    turn, region, damp, shape, half_width, half_height, rim, segments
         As in `smooth_substeps`.
     origin : float
         The clock's origin, s.
@@ -152,10 +160,16 @@ def smooth_intervals(
         Most substeps in an interval (a power of two).
     energy_floor : float
         As in `smooth_substeps`.
+    given : float
+        The energy the velocity forces have given the particles before the first interval, J
+        (`collidium.collisions.Tally.forces`).
     record : ndarray, shape (count, len(RECORD))
         Output: the `RECORD` of each interval's end, summed as `collidium.simulation.Simulation`
         sums them (`collidium.kernels.sums`, and the forces' as
         `collidium.forces.base.ForceField` sums them).
+    heat : ndarray, shape (count,)
+        Output: ``given`` at each interval's end, each interval's drag added as the integrator
+        adds it to the tally.
 
     Returns
     -------
@@ -165,23 +179,24 @@ def smooth_intervals(
     n = position.shape[0]
     work = _work(mass, source)
     walls = (shape, half_width, half_height, rim, segments)
-    external = (uniform, turn, region)
+    external = (uniform, fall, turn, region, damp)
     start = np.empty((3, n, 2))
     sources = work[3:12]
     energy, virial = _energies(position, coupling, softening2, uniform, sources)
     for k in range(count):
         now = origin + (elapsed + k) * dt
         total = kinetic_energy(mass, velocity) + energy
-        rate2 = _squared_rate(position, velocity, mass, coupling, softening2, turn, total,
+        rate2 = _squared_rate(position, velocity, mass, coupling, softening2, turn, damp, total,
                               energy_floor, sources)  # fmt: skip
         if not dt * math.sqrt(rate2) <= most_substeps * tolerance:  # also NaN
             return k, substeps
         taken = max(substeps, needed(rate2, dt, tolerance, most_substeps))
         _keep(position, velocity, acceleration, start)
         while True:
-            s, _, fastest = _substeps(position, velocity, acceleration, mass, radius, coupling,
-                                      softening2, external, walls, now, dt, 1, taken, now, rate2,
-                                      total, energy_floor, work)  # fmt: skip
+            s, _, fastest, drag = _substeps(position, velocity, acceleration, mass, radius,
+                                            coupling, softening2, external, walls, now, dt, 1,
+                                            taken, now, rate2, total, energy_floor,
+                                            work)  # fmt: skip
             if s <= taken:  # a contact, or a value not finite
                 _restore(position, velocity, acceleration, start)
                 return k, substeps
@@ -191,6 +206,8 @@ def smooth_intervals(
             _restore(position, velocity, acceleration, start)
             taken = max(required, 2 * taken)
         substeps = max(1, taken // 2) if required <= taken // 2 else taken
+        given += drag
+        heat[k] = given
         energy, virial = _energies(position, coupling, softening2, uniform, sources)
         px, py = momentum(mass, velocity)
         record[k, 0] = kinetic_energy(mass, velocity)
@@ -244,8 +261,8 @@ def _work(mass, source):
 @uncounted(error_model="numpy")
 def _substeps(position, velocity, acceleration, mass, radius, coupling, softening2, external,
               walls, now, dt, first, count, t, fastest, total, energy_floor, work):  # fmt: skip
-    """`smooth_substeps` in its work arrays (`_work`), the uniform and magnetic fields as one
-    tuple (``uniform, turn, region``), the vessel as another.
+    """`smooth_substeps` in its work arrays (`_work`), the uniform field and the velocity
+    forces as one tuple (``uniform, fall, turn, region, damp``), the vessel as another.
 
     Compiled without reference counting (`uncounted`), as are the pair sums it calls: the
     atomic counts numba puts around array arguments were 0.35 us of a two-body substep's
@@ -253,40 +270,51 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     kicked, flown, pull = work[:3]
     index, charged, inverse_mass, x, y, vx, vy, sums, buffer = work[3:12]
     order, low, high = work[12:]
-    uniform, turn, region = external
+    uniform, fall, turn, region, damp = external
     n = position.shape[0]
+    given = 0.0
     if fastest < 0.0:
-        fastest = _squared_rate(position, velocity, mass, coupling, softening2, turn, total,
+        fastest = _squared_rate(position, velocity, mass, coupling, softening2, turn, damp, total,
                                 energy_floor, work[3:12])  # fmt: skip
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
-        _turn(position, velocity, turn, region, 0.5 * h, kicked)
-        for i in range(n):
-            for d in range(2):
-                kicked[i, d] += (0.5 * h) * acceleration[i, d]
+        before = _flow(position, velocity, mass, turn, region, damp, 0.5 * h, kicked)
+        _kick(kicked, acceleration, fall, 0.5 * h)
         if not _finite(kicked) or _meets_contact(position, kicked, radius, h, walls, order, low,
                                                  high):  # fmt: skip
-            return s, t, fastest
+            return s, t, fastest, given
         for i in range(n):
             for d in range(2):
                 flown[i, d] = position[i, d] + kicked[i, d] * h
-        _accelerations(flown, mass, coupling, softening2, uniform, index, charged, x, y, sums,
-                       buffer, pull)  # fmt: skip
+        _accelerations(flown, mass, coupling, softening2, uniform, fall, index, charged, x, y,
+                       sums, buffer, pull)  # fmt: skip
         if not _finite(pull):
-            return s, t, fastest
+            return s, t, fastest, given
         for i in range(n):
             for d in range(2):
                 position[i, d] = flown[i, d]
-                velocity[i, d] = kicked[i, d] + (0.5 * h) * pull[i, d]
+                velocity[i, d] = kicked[i, d]
                 acceleration[i, d] = pull[i, d]
-        _turn(position, velocity, turn, region, 0.5 * h, velocity)
+        _kick(velocity, acceleration, fall, 0.5 * h)
+        after = _flow(position, velocity, mass, turn, region, damp, 0.5 * h, velocity)
+        given += before + after
         t = end
-        rate2 = _rate(position, velocity, mass, coupling, softening2, turn, total, energy_floor,
-                      index, charged, inverse_mass, x, y, vx, vy)  # fmt: skip
+        rate2 = _rate(position, velocity, mass, coupling, softening2, turn, damp, total + given,
+                      energy_floor, index, charged, inverse_mass, x, y, vx, vy)  # fmt: skip
         if rate2 > fastest:
             fastest = rate2
-    return count + 1, t, fastest
+    return count + 1, t, fastest, given
+
+
+@numba.njit(cache=True, inline="always")
+def _kick(velocity, acceleration, fall, lag) -> None:
+    """``v += (a + fall) lag`` in place, ``velocity`` and ``acceleration`` (N, 2) in m/s and
+    m/s^2, the carried ``fall`` (2,) only where there is one."""
+    for i in range(velocity.shape[0]):
+        for d in range(2):
+            pull = acceleration[i, d] if fall.shape[0] == 0 else acceleration[i, d] + fall[d]
+            velocity[i, d] += lag * pull
 
 
 @uncounted()
@@ -331,11 +359,12 @@ def _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffe
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _accelerations(position, mass, coupling, softening2, uniform, index, charged, x, y, sums,
-                   buffer, out) -> None:  # fmt: skip
+def _accelerations(position, mass, coupling, softening2, uniform, fall, index, charged, x, y,
+                   sums, buffer, out) -> None:  # fmt: skip
     """The accelerations (N, 2) of the pair force and the ``uniform`` field's forces (N, 2), or
-    (0, 2) without one) into ``out``: the forces over the masses, as
-    `collidium.forces.base.ForceField.evaluate` forms them (`_pair_sums`)."""
+    (0, 2) without one; not where the drift carries it, ``fall`` not empty) into ``out``: the
+    forces over the masses, as `collidium.forces.base.ForceField.evaluate` forms them
+    (`_pair_sums`)."""
     _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffer)
     for i in range(position.shape[0]):  # loops: an array expression costs more than 3 bodies
         out[i, 0] = 0.0
@@ -343,7 +372,7 @@ def _accelerations(position, mass, coupling, softening2, uniform, index, charged
     for c in range(index.shape[0]):
         out[index[c], 0] += sums[0, c]
         out[index[c], 1] += sums[1, c]
-    for i in range(uniform.shape[0]):
+    for i in range(uniform.shape[0] if fall.shape[0] == 0 else 0):
         out[i, 0] += uniform[i, 0]
         out[i, 1] += uniform[i, 1]
     for i in range(position.shape[0]):
@@ -373,23 +402,24 @@ def _energies(position, coupling, softening2, uniform, sources) -> tuple[float, 
 
 
 @uncounted(error_model="numpy")
-def _squared_rate(position, velocity, mass, coupling, softening2, turn, total, floor,
+def _squared_rate(position, velocity, mass, coupling, softening2, turn, damp, total, floor,
                   sources) -> float:  # fmt: skip
     """`_rate` with the arrays of `_work` from the indices to the sums' buffer (``sources``)."""
     index, charged, inverse_mass, x, y, vx, vy, _, _ = sources
-    return _rate(position, velocity, mass, coupling, softening2, turn, total, floor, index,
+    return _rate(position, velocity, mass, coupling, softening2, turn, damp, total, floor, index,
                  charged, inverse_mass, x, y, vx, vy)  # fmt: skip
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")  # that of the inlined rows
-def _rate(position, velocity, mass, coupling, softening2, turn, total, floor, index, charged,
-          inverse_mass, x, y, vx, vy) -> float:  # fmt: skip
+def _rate(position, velocity, mass, coupling, softening2, turn, damp, total, floor, index,
+          charged, inverse_mass, x, y, vx, vy) -> float:  # fmt: skip
     """`collidium.integrators._squared_rate`, 1/s^2, given the total energy (J): the square
     root of the largest ``(|U_ij| rate_ij^2)^2`` over pairs
     (`collidium.kernels.pairwise.inverse_distance_stiffness`, by its rows, from the particles
     with a source ``index`` gathered into ``x, y, vx, vy``) over the energy scale, or the
-    square of the fastest cyclotron frequency ``turn`` (inside the field's region or not, as
-    `collidium.forces.magnetic.MagneticField.rate`), whichever is larger."""
+    square of the fastest rate of the velocity forces (the cyclotron frequencies ``turn``,
+    inside the field's region or not, and the damping rates ``damp``, as their forces' `rate`
+    gives them), whichever is larger."""
     for c in range(index.shape[0]):
         i = index[c]
         x[c], y[c] = position[i, 0], position[i, 1]
@@ -401,21 +431,30 @@ def _rate(position, velocity, mass, coupling, softening2, turn, total, floor, in
         stiffness = larger(stiffness, row)
     scale = energy_scale(kinetic_energy(mass, velocity), total, floor)
     energy = math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
-    spin = 0.0
+    fastest = 0.0
     for i in range(turn.shape[0]):
-        spin = max(spin, abs(turn[i]))
-    return max(energy, spin * spin)
+        fastest = max(fastest, abs(turn[i]))
+    for i in range(damp.shape[0]):
+        fastest = max(fastest, damp[i])
+    return max(energy, fastest * fastest)
 
 
 @numba.njit(cache=True, inline="always")
-def _turn(position, velocity, turn, region, lag, out) -> None:
-    """The magnetic field's flow for ``lag`` seconds: each velocity (N, 2) of a particle inside
-    the ``region`` (left, bottom, right, top, m) at ``position`` turned by ``-turn lag``
-    (`collidium.forces.magnetic.MagneticField.advance`), into ``out`` (which may be
-    ``velocity``); the others copied. Without a field (``turn`` empty), a copy."""
+def _flow(position, velocity, mass, turn, region, damp, lag, out) -> float:
+    """The velocity forces' flows for ``lag`` seconds, from ``velocity`` (N, 2) into ``out``
+    (which may be ``velocity``): each velocity damped by ``exp(-damp lag)``
+    (`collidium.forces.drag.LinearDrag.advance`) and, for a particle inside the ``region`` (left,
+    bottom, right, top, m) at ``position``, turned by ``-turn lag``
+    (`collidium.forces.magnetic.MagneticField.advance`); the two commute. Without either
+    (``damp`` or ``turn`` empty), that one is left out. Returns the energy the drag gave, J."""
     left, bottom, right, top = region[0], region[1], region[2], region[3]
+    given = 0.0
     for i in range(velocity.shape[0]):
         vx, vy = velocity[i, 0], velocity[i, 1]
+        if damp.shape[0] > 0:
+            factor = math.exp(-damp[i] * lag)
+            given += 0.5 * mass[i] * (vx * vx + vy * vy) * (factor * factor - 1.0)
+            vx, vy = vx * factor, vy * factor
         x, y = position[i, 0], position[i, 1]
         if turn.shape[0] > 0 and left <= x <= right and bottom <= y <= top:
             angle = -turn[i] * lag
@@ -423,6 +462,7 @@ def _turn(position, velocity, turn, region, lag, out) -> None:
             vx, vy = cos * vx - sin * vy, sin * vx + cos * vy
         out[i, 0] = vx
         out[i, 1] = vy
+    return given
 
 
 @numba.njit(cache=True, inline="always")

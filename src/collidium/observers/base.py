@@ -162,6 +162,8 @@ class Flown:
     counts, impulse, heat : ndarray, shape (K, 1 + W)
         The tallies (`collidium.collisions.Tally`): collisions and wall hits, the collision
         virial and the walls' impulses, the heat given.
+    forces : ndarray, shape (K,)
+        The energy the velocity forces have given, J (`Simulation.force_heat`).
     """
 
     time: FloatArray
@@ -174,6 +176,7 @@ class Flown:
     counts: IntArray
     impulse: FloatArray
     heat: FloatArray
+    forces: FloatArray
 
 
 @runtime_checkable

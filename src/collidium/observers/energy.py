@@ -211,10 +211,9 @@ class EnergyDrift(Measurement):
 
     def take_flown(self, sim: Simulation, flown: Flown) -> None:
         """Samples of steps the run flew in one compiled call (`Flown`): the same as `update`
-        after each (no forces gave energy in between: a flight has none that do)."""
-        forces = sim.force_heat()
+        after each."""
         totals = (flown.kinetic + flown.potential).tolist()
-        for total, heat in zip(totals, flown.heat, strict=True):
+        for total, heat, forces in zip(totals, flown.heat, flown.forces.tolist(), strict=True):
             self._take(total - given_energy(heat, forces))
         self.samples += flown.time.shape[0]
 
