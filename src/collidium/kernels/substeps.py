@@ -61,7 +61,7 @@ def smooth_substeps(
     ``dt`` (s), in place, up to the first that may meet a contact.
 
     Substep s ends at ``now + dt s / count``; it is the velocity forces' flow for ``h / 2``
-    (`_flow`: the drag, the magnetic field's turn), a kick ``v += a h / 2``, the straight flight
+    (`_flowed`: the drag, the magnetic field's turn), a kick ``v += a h / 2``, the straight flight
     over h, the accelerations at the new positions, the kick ``v += a h / 2`` and the flow for
     ``h / 2``. After each, the squared rate of the forces weighted by energy
     (`collidium.integrators._squared_rate`) raises ``fastest``. No energy is summed: the rate's
@@ -86,11 +86,11 @@ def smooth_substeps(
         Empty where ``uniform`` is in ``acceleration``.
     turn : ndarray, shape (N,) or (0,)
         A magnetic field's signed cyclotron frequency ``q B / m`` of each particle, rad/s
-        (`_flow`); empty without one.
+        (`_flowed`); empty without one.
     region : ndarray, shape (4,)
         Where the magnetic field acts: left, bottom, right, top (m), infinite for the plane.
     damp : ndarray, shape (N,) or (0,)
-        A linear drag's ``gamma / m`` of each particle, 1/s (`_flow`); empty without one.
+        A linear drag's ``gamma / m`` of each particle, 1/s (`_flowed`); empty without one.
     shape, half_width, half_height, rim, segments
         The vessel as the exact engine has it (`collidium.kernels.vessels.contacts.earliest`).
     now, dt : float
@@ -279,8 +279,13 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
-        before = _flow(position, velocity, mass, turn, region, damp, 0.5 * h, kicked)
-        _kick(kicked, acceleration, fall, 0.5 * h)
+        before = 0.0
+        for i in range(n):  # the flow for h / 2, then the kick
+            wx, wy, heat = _flowed(i, velocity[i, 0], velocity[i, 1], position, mass, turn,
+                                   region, damp, 0.5 * h)  # fmt: skip
+            kicked[i, 0] = _kicked(wx, acceleration[i, 0], fall, 0, 0.5 * h)
+            kicked[i, 1] = _kicked(wy, acceleration[i, 1], fall, 1, 0.5 * h)
+            before += heat
         if not _finite(kicked) or _meets_contact(position, kicked, radius, h, walls, order, low,
                                                  high):  # fmt: skip
             return s, t, fastest, given
@@ -291,13 +296,16 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
                        sums, buffer, pull)  # fmt: skip
         if not _finite(pull):
             return s, t, fastest, given
-        for i in range(n):
+        after = 0.0
+        for i in range(n):  # the kick, then the flow for h / 2
             for d in range(2):
                 position[i, d] = flown[i, d]
-                velocity[i, d] = kicked[i, d]
                 acceleration[i, d] = pull[i, d]
-        _kick(velocity, acceleration, fall, 0.5 * h)
-        after = _flow(position, velocity, mass, turn, region, damp, 0.5 * h, velocity)
+            wx = _kicked(kicked[i, 0], pull[i, 0], fall, 0, 0.5 * h)
+            wy = _kicked(kicked[i, 1], pull[i, 1], fall, 1, 0.5 * h)
+            velocity[i, 0], velocity[i, 1], heat = _flowed(i, wx, wy, position, mass, turn,
+                                                           region, damp, 0.5 * h)  # fmt: skip
+            after += heat
         given += before + after
         t = end
         rate2 = _rate(position, velocity, mass, coupling, softening2, turn, damp, total + given,
@@ -308,13 +316,10 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
 
 
 @numba.njit(cache=True, inline="always")
-def _kick(velocity, acceleration, fall, lag) -> None:
-    """``v += (a + fall) lag`` in place, ``velocity`` and ``acceleration`` (N, 2) in m/s and
-    m/s^2, the carried ``fall`` (2,) only where there is one."""
-    for i in range(velocity.shape[0]):
-        for d in range(2):
-            pull = acceleration[i, d] if fall.shape[0] == 0 else acceleration[i, d] + fall[d]
-            velocity[i, d] += lag * pull
+def _kicked(v: float, a: float, fall, d: int, lag: float) -> float:
+    """A velocity component ``v`` (m/s) kicked by ``(a + fall[d]) lag``, ``a`` in m/s^2, the
+    carried ``fall`` (2,) only where there is one."""
+    return v + lag * (a if fall.shape[0] == 0 else a + fall[d])
 
 
 @uncounted()
@@ -440,29 +445,25 @@ def _rate(position, velocity, mass, coupling, softening2, turn, damp, total, flo
 
 
 @numba.njit(cache=True, inline="always")
-def _flow(position, velocity, mass, turn, region, damp, lag, out) -> float:
-    """The velocity forces' flows for ``lag`` seconds, from ``velocity`` (N, 2) into ``out``
-    (which may be ``velocity``): each velocity damped by ``exp(-damp lag)``
-    (`collidium.forces.drag.LinearDrag.advance`) and, for a particle inside the ``region`` (left,
-    bottom, right, top, m) at ``position``, turned by ``-turn lag``
-    (`collidium.forces.magnetic.MagneticField.advance`); the two commute. Without either
-    (``damp`` or ``turn`` empty), that one is left out. Returns the energy the drag gave, J."""
-    left, bottom, right, top = region[0], region[1], region[2], region[3]
+def _flowed(i, vx, vy, position, mass, turn, region, damp, lag) -> tuple[float, float, float]:
+    """The velocity forces' flows for ``lag`` seconds of particle i's velocity ``(vx, vy)``
+    (m/s): damped by ``exp(-damp[i] lag)`` (`collidium.forces.drag.LinearDrag.advance`) and,
+    inside the ``region`` (left, bottom, right, top, m) at its ``position``, turned by
+    ``-turn[i] lag`` (`collidium.forces.magnetic.MagneticField.advance`); the two commute.
+    Without either (``damp`` or ``turn`` empty), that one is left out. Returns the new
+    velocity and the energy the drag gave, J."""
     given = 0.0
-    for i in range(velocity.shape[0]):
-        vx, vy = velocity[i, 0], velocity[i, 1]
-        if damp.shape[0] > 0:
-            factor = math.exp(-damp[i] * lag)
-            given += 0.5 * mass[i] * (vx * vx + vy * vy) * (factor * factor - 1.0)
-            vx, vy = vx * factor, vy * factor
+    if damp.shape[0] > 0:
+        factor = math.exp(-damp[i] * lag)
+        given = 0.5 * mass[i] * (vx * vx + vy * vy) * (factor * factor - 1.0)
+        vx, vy = vx * factor, vy * factor
+    if turn.shape[0] > 0:
         x, y = position[i, 0], position[i, 1]
-        if turn.shape[0] > 0 and left <= x <= right and bottom <= y <= top:
+        if region[0] <= x <= region[2] and region[1] <= y <= region[3]:
             angle = -turn[i] * lag
             cos, sin = math.cos(angle), math.sin(angle)
             vx, vy = cos * vx - sin * vy, sin * vx + cos * vy
-        out[i, 0] = vx
-        out[i, 1] = vy
-    return given
+    return vx, vy, given
 
 
 @numba.njit(cache=True, inline="always")
