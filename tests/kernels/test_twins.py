@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from collidium.kernels import reference
-from collidium.kernels.audit import all_valid, first_invalid
+from collidium.kernels.audit import all_valid, first_invalid, first_past_face
 from collidium.kernels.placement import place_disks
 from collidium.kernels.vessels import BOX, CIRCLE
 from collidium.kernels.vessels.box import DRIFT_CHUNK, drift_periodic, drift_reflecting, fold
@@ -88,6 +88,28 @@ def test_audit_equals_twin(rng, shape, periodic, n):
         found = min(index for index, *_ in bad)
         inside = (periodic and bad[0][0] == 57) or (shape == BOX and bad is corner)
         assert want[0] == (-1 if inside and len(bad) == 1 else found)
+
+
+@pytest.mark.parametrize(("axis", "sign"), [(0, -1.0), (0, 1.0), (1, -1.0), (1, 1.0)])
+def test_piston_audit_equals_twin(rng, axis, sign):
+    """A piston's face at 2 m along either axis, facing either way: the first disk reaching past
+    it by more than the allowance is found, as by the twin; none when all are behind it, and
+    a centre that is not finite is left to `first_invalid`."""
+    n = 300
+    radius = np.full(n, 0.1)
+    position = rng.uniform(-3.0, 3.0, (n, 2))
+    position[:, axis] = sign * rng.uniform(-3.0, -2.1, n) + 2.0  # behind the face
+    face = (axis, sign, 2.0, 1e-9)
+    assert first_past_face(position, radius, *face) == reference.first_past_face(
+        position, radius, *face
+    ) == -1  # fmt: skip
+    position[17, axis] = 2.0 - sign * 0.1 + sign * 2e-9  # past by twice the allowance
+    position[9, axis] = 2.0 - sign * 0.1 + sign * 5e-10  # within it
+    position[5] = np.nan
+    assert first_past_face(position, radius, *face) == 17
+    assert reference.first_past_face(position, radius, *face) == 17
+    position[200, axis] = 2.0 + sign * 3.0
+    assert first_past_face(position, radius, *face) == 17
 
 
 def _fold_in_index_order(position, velocity, radius, mass, half, dt):

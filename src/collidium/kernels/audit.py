@@ -59,6 +59,18 @@ def first_invalid(
 
 
 @uncounted()
+def first_past_face(position, radius, axis, sign, face, allowance) -> int:
+    """The first disk reaching past a piston's face by more than ``allowance`` (m), or -1: past
+    when ``sign (position[i, axis] - face) + radius[i]`` exceeds it
+    (`collidium.vessels.Vessel.piston_face`). A centre that is not finite is not past
+    (`first_invalid` finds it)."""
+    for i in range(position.shape[0]):
+        if sign * (position[i, axis] - face) + radius[i] > allowance:
+            return i
+    return -1
+
+
+@uncounted()
 def in_order(position, velocity, radius, shape, limit_x, limit_y, slack, periodic, segments):
     """`first_invalid` in one pass, particle by particle, compiled: ``(index, reason)``."""
     return _first_between(0, position.shape[0], position, velocity, radius, shape, limit_x,

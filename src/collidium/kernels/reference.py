@@ -541,6 +541,15 @@ def place_disks(
     return placed
 
 
+def first_past_face(
+    position: FloatArray, radius: FloatArray, axis: int, sign: float, face: float, allowance: float
+) -> int:
+    """Twin of `audit.first_past_face`: the first disk with ``sign (x[axis] - face) + r`` above
+    the allowance, or -1."""
+    past = np.flatnonzero(sign * (position[:, axis] - face) + radius > allowance)
+    return int(past[0]) if past.size else -1
+
+
 def first_invalid(
     position: FloatArray,
     velocity: FloatArray,

@@ -218,9 +218,20 @@ class Vessel(ABC):
     def _past_piston(
         self, position: FloatArray, radius: FloatArray, piston_at: float | None
     ) -> BoolArray:
-        """Which disks reach past the piston's face at ``piston_at`` (m), shape (N,); none
-        without a piston."""
-        return np.zeros(len(position), dtype=bool)
+        """Which disks reach past the piston's face at ``piston_at`` (m) by more than round-off
+        (`piston_face`), shape (N,); none without a piston."""
+        face = self.piston_face(piston_at)
+        if face is None:
+            return np.zeros(len(position), dtype=bool)
+        axis, sign, at, allowance = face
+        return np.asarray(sign * (position[:, axis] - at) + radius > allowance)
+
+    def piston_face(self, piston_at: float | None = None) -> tuple[int, float, float, float] | None:
+        """The piston's face as the audit tests it (`collidium.kernels.audit.first_past_face`):
+        ``(axis, sign, face, allowance)``, a disk being past it when ``sign (x[axis] - face) +
+        r`` exceeds the allowance (m); its face at ``piston_at`` (m along its axis; default:
+        where it starts). None without a piston."""
+        return None
 
     @abstractmethod
     def _outside_shape(self, position: FloatArray, radius: FloatArray) -> BoolArray:

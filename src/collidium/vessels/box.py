@@ -266,17 +266,15 @@ class Box(Vessel):
         line[:, axis] = face
         return line
 
-    def _past_piston(
-        self, position: FloatArray, radius: FloatArray, piston_at: float | None
-    ) -> BoolArray:
-        """Disks reaching past the piston's face by more than round-off."""
+    def piston_face(self, piston_at: float | None = None) -> tuple[int, float, float, float] | None:
+        """`Vessel.piston_face`: the piston's wall's axis and outward sign, its face, and the
+        round-off allowance of the box's walls."""
         if self.piston is None:
-            return np.zeros(len(position), dtype=bool)
+            return None
         wall, piston = self.piston
         face = piston.position if piston_at is None else piston_at
         axis, sign = wall_axis(wall)
-        reach = sign * (position[:, axis] - face) + radius
-        return np.asarray(reach > OUTSIDE_TOLERANCE * 0.5 * float(self.size.max()))
+        return axis, sign, float(face), OUTSIDE_TOLERANCE * 0.5 * float(self.size.max())
 
     def describe(self) -> str:
         """``'20 x 10 box (centred on 0, 0)'``, with ``periodic`` when it is."""
