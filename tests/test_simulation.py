@@ -416,6 +416,20 @@ def _falling_in_a_periodic_box() -> cd.Simulation:
     return cd.Simulation(box, particles, forces=[cd.Gravity((0.0, -2.0))], dt=0.01)
 
 
+def _counting_flights(monkeypatch) -> list[int]:
+    """The steps each call of `ExactCollisions.fly` takes, as they come."""
+    flown_steps: list[int] = []
+    fly = ExactCollisions.fly
+
+    def counted(self, *args):
+        flown = fly(self, *args)
+        flown_steps.append(flown)
+        return flown
+
+    monkeypatch.setattr(ExactCollisions, "fly", counted)
+    return flown_steps
+
+
 @pytest.mark.parametrize(
     ("scene", "time"),
     [("gas", 2.0), ("pool-break", 0.5), ("circle-gas", 1.0), ("heat-flow", 1.0),
@@ -432,15 +446,7 @@ def test_exact_steps_flown_without_kicks_are_bitwise_those_taken_one_by_one(
     give heat (heat-flow), inelastic collisions (granular), segments (effusion), disks that
     leave the engine's cell window, and a gravity's potential energy (atmosphere; in a periodic
     box, of the unwrapped positions)."""
-    flown_steps = []
-    fly = ExactCollisions.fly
-
-    def counted(self, *args):
-        flown = fly(self, *args)
-        flown_steps.append(flown)
-        return flown
-
-    monkeypatch.setattr(ExactCollisions, "fly", counted)
+    flown_steps = _counting_flights(monkeypatch)
     runs = []
     for reader in (StateReader(Every(250)), StateReader(Every(1))):
         sim = cd.load(scene) if isinstance(scene, str) else scene()
@@ -465,6 +471,56 @@ def test_exact_steps_flown_without_kicks_are_bitwise_those_taken_one_by_one(
         assert a.summary() == b.summary() or _same_with_nan(a.summary(), b.summary())
     for column in ("time", "kinetic", "potential", "total_speed", "momentum"):
         np.testing.assert_array_equal(getattr(ours[2], column), getattr(theirs[2], column))
+
+
+@pytest.mark.parametrize("compress", [0.0, 0.5])
+def test_a_piston_flies_its_steps_bitwise_as_one_by_one(monkeypatch, compress):
+    """A gas under a free piston, or under one driven in: where no observer reads what a flight
+    records, the steps between the observers of the state fly in compiled calls, the piston
+    moving in them, and the run ends bit for bit as one stepped, piston included. An observer
+    that reads the record every step keeps every step in Python (the record holds no piston)."""
+    flown_steps = _counting_flights(monkeypatch)
+    runs = []
+    for reader in (StateReader(Every(250)), StateReader(Every(1))):
+        sim = cd.load("piston", compress=compress)
+        sim.observers = [reader]
+        sim.run(time=3.0)
+        runs.append((sim, sum(flown_steps)))
+        flown_steps.clear()
+    (flown, steps_flown), (stepped, none) = runs
+    assert steps_flown >= flown.steps - 10 and none == 0
+    np.testing.assert_array_equal(flown.particles.position, stepped.particles.position)
+    np.testing.assert_array_equal(flown.particles.velocity, stepped.particles.velocity)
+    np.testing.assert_array_equal(flown.tally.piston, stepped.tally.piston)
+    assert flown.tally.counts[1:].sum() > 100  # the gas and the piston met
+    assert flown.counters == stepped.counters
+    assert flown.piston() == stepped.piston()
+    for name in ("events", "rebuilds"):
+        assert getattr(flown._drift, name) == getattr(stepped._drift, name)
+    watched = cd.load("piston", compress=compress)
+    watched.observers = [cd.observers.Thermo(1)]
+    watched.run(time=0.5)
+    assert flown_steps and max(flown_steps) == 0
+
+
+def test_a_flight_stops_at_the_step_that_leaves_a_disk_past_the_piston(monkeypatch):
+    """The flights audit the piston's face after each step, as the run loop does: with a face
+    that counts a disk within 0.3 m of it as past, a flown run stops at the same step, with the
+    same message, as a stepped one."""
+    face = cd.Box.piston_face
+
+    def wide(self, piston_at=None):
+        return (*face(self, piston_at)[:3], -0.3)
+
+    monkeypatch.setattr(cd.Box, "piston_face", wide)
+    stops = []
+    for reader in (StateReader(Every(250)), StateReader(Every(1))):
+        sim = cd.load("piston")
+        sim.observers = [reader]
+        with pytest.raises(cd.SimulationError, match="left the vessel") as caught:
+            sim.run(time=3.0)
+        stops.append((sim.steps, str(caught.value)))
+    assert stops[0] == stops[1] and 1 < stops[0][0] < 300
 
 
 class StepRecorder:

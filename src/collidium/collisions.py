@@ -500,6 +500,8 @@ class ExactCollisions:
         #: Events per particle between re-sorts of the engine's memory by cell (speed only).
         self.sort_interval = events.SORT_INTERVAL
         self._halt = np.full(events.HALT_SIZE, math.inf)
+        #: Where a flight leaves the piston's face (`Tally.piston`'s two values).
+        self._piston_now = np.zeros(2)
 
     def state(self) -> dict[str, np.ndarray]:
         """The event queue and lazily updated positions, and the event counters."""
@@ -651,16 +653,12 @@ class ExactCollisions:
 
     def flies(self, particles: Particles, tally: Tally, fall: FloatArray) -> bool:
         """Whether `fly` may take steps now: the queue is built for this ``fall``, nobody
-        changed the particles since it wrote them, the vessel has no piston, and the particles
-        are fewer than `collidium.kernels.audit.PARALLEL_FROM` (`Drift.flies`). With more, a
-        step takes milliseconds, its Python is nothing beside them, and the run loop's audit
-        runs on every core where the flight's would run on one (a 1e5-disk gas's step took 7-10%
-        longer flown)."""
-        return (
-            particles.n < audit.PARALLEL_FROM
-            and tally.piston.size == 0
-            and self._is_current(particles, tally.piston, fall)
-        )
+        changed the particles since it wrote them, and the particles are fewer than
+        `collidium.kernels.audit.PARALLEL_FROM` (`Drift.flies`). With more, a step takes
+        milliseconds, its Python is nothing beside them, and the run loop's audit runs on every
+        core where the flight's would run on one (a 1e5-disk gas's step took 7-10% longer
+        flown)."""
+        return particles.n < audit.PARALLEL_FROM and self._is_current(particles, tally.piston, fall)
 
     def fly(
         self,
@@ -674,8 +672,9 @@ class ExactCollisions:
         fall: FloatArray,
     ) -> int:
         """Steps in one compiled call (`Drift.fly`,
-        `collidium.kernels.event_flights.event_intervals`)."""
-        if not self.flies(particles, tally, fall):
+        `collidium.kernels.event_flights.event_intervals`). With a piston, only where no
+        observer reads the record: it holds no piston, and the vessel changes as it moves."""
+        if not self.flies(particles, tally, fall) or (tally.piston.size and record.wanted.any()):
             return 0
         s = self._state
         assert s is not None
@@ -683,6 +682,7 @@ class ExactCollisions:
         self._halt[events.HALT_AFTER] = math.inf
         fall_x, fall_y = (float(g) for g in fall)
         width, height = (float(side) for side in vessel.size)
+        face = vessel.piston_face()
         p = particles
         taken, processed, ending = event_flights.event_intervals(
             origin, elapsed, dt, record.values.shape[0], s["body"], p.image, s["geometry"],
@@ -692,11 +692,13 @@ class ExactCollisions:
             p.velocity, writable(p.mass), writable(p.radius), fall_x, fall_y, width, height,
             _runaway_reach(vessel),
             *vessel.audit_arguments(), bool(s["grid"][2]) or _window_is_vessel(s["geometry"],
-            s["grid"]), record.values, record.counts, record.impulse, record.heat, record.wanted,
+            s["grid"]), 0.0 if face is None else face[3], self._piston_now, record.values,
+            record.counts, record.impulse, record.heat, record.wanted,
         )  # fmt: skip
         self.events += processed
         if taken:
             self._synced_at = origin + (elapsed + taken - 1) * dt + dt  # as `drift` adds them
+            tally.piston[...] = self._piston_now[: tally.piston.size]
         if ending == event_flights.OUT_OF_WINDOW:
             self._spare, self._state = self._state, None  # as `drift`: a larger window next
         elif ending < 0:

@@ -17,10 +17,11 @@ advancing.
 from __future__ import annotations
 
 from collidium.kernels import events
-from collidium.kernels.audit import all_valid
+from collidium.kernels.audit import all_valid, first_past_face
 from collidium.kernels.compilation import uncounted
 from collidium.kernels.floats import largest_magnitude
 from collidium.kernels.sums import kinetic_energy, momentum, total_speed
+from collidium.kernels.vessels import piston as piston_kernels
 
 #: How `event_intervals` ended: every interval taken; at an interval that the drift must take
 #: (its speeds are refused, or the audit fails after it: the interval counts as taken then);
@@ -33,7 +34,8 @@ def event_intervals(
     origin, elapsed, dt, count, body, image, geometry, grid, head, next_, event, keys, items,
     tally, impulse, acceleration, sort_every, halt, walls, heat, segments, piston, position,
     velocity, mass, radius, fall_x, fall_y, width, height, reach, audit_shape, limit_x, limit_y,
-    slack, periodic, window_is_vessel, record, counts, impulses, heats, wanted,
+    slack, periodic, window_is_vessel, piston_allowance, piston_now, record, counts, impulses,
+    heats, wanted,
 ) -> tuple[int, int, int]:  # fmt: skip
     """Up to ``count`` steps of ``dt`` (s) of the exact engine without forces, or under the one
     uniform gravity it carries, in place.
@@ -65,6 +67,12 @@ def event_intervals(
     window_is_vessel : bool
         Whether the cells' window covers the vessel (disks outside it are then no reason to
         build the queue again).
+    piston_allowance : float
+        How far past the ``piston``'s face (if any) a disk may reach, round-off (m;
+        `collidium.vessels.Vessel.piston_face`): the audit tests it after each step.
+    piston_now : ndarray, shape (2,)
+        Output, with a piston: its face's position and velocity along its axis at the last
+        step's end (m, m/s), as `collidium.collisions.Tally.piston` keeps them.
     record : ndarray, shape (count, len(RECORD))
         Output: `collidium.kernels.substeps.RECORD` at the end of each step ``wanted`` (no pair
         virial: 0); the other rows are left as they are.
@@ -101,12 +109,29 @@ def event_intervals(
             if falls:
                 record[k, 1] = 0.0 + _fall_energy(position, image, mass, fall_x, fall_y,
                                                   periodic, width, height)  # fmt: skip
-        if not all_valid(position, velocity, radius, audit_shape, limit_x, limit_y, slack,
-                         periodic, segments):  # fmt: skip
+        invalid = not all_valid(position, velocity, radius, audit_shape, limit_x, limit_y,
+                                slack, periodic, segments)  # fmt: skip
+        if piston.shape[0] > 0:
+            invalid = _piston_at(piston, until, position, radius, piston_allowance,
+                                 piston_now) or invalid  # fmt: skip
+        if invalid:
             return k + 1, processed, STOPPED
         if strays > 0 and not window_is_vessel:
             return k + 1, processed, OUT_OF_WINDOW
     return count, processed, ALL
+
+
+@uncounted()
+def _piston_at(piston, t, position, radius, allowance, now) -> bool:
+    """The piston's face at time t (s) into ``now`` (2,) (position and velocity along its axis,
+    as `collidium.collisions.Tally.piston`); whether a disk reaches past it by more than the
+    ``allowance`` (m; `collidium.kernels.audit.first_past_face`)."""
+    height, speed = piston_kernels.motion(piston, t)
+    wall = int(piston[piston_kernels.WALL])
+    sign = 1.0 if wall % 2 == 1 else -1.0
+    now[0] = sign * height
+    now[1] = sign * speed
+    return first_past_face(position, radius, wall // 2, sign, now[0], allowance) >= 0
 
 
 @uncounted()

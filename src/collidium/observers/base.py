@@ -146,7 +146,8 @@ class Flown:
     """What a run records of the steps it flew in one compiled call (`Simulation.run`: exact
     collisions without forces or under a gravity alone, or a small charged scene), at those an
     observer's trigger fired on, as `Simulation` gives them at each. The vessel did not change in
-    between (a flight has no piston). Arrays of K rows, one per step.
+    between (a flight with a piston has no steps an observer reads). Arrays of K rows, one per
+    step.
 
     Attributes
     ----------
