@@ -82,6 +82,11 @@ def test_a_sweep_run_again_skips_the_runs_it_has(tmp_path, two_workers):
     pandas.testing.assert_frame_equal(pandas.read_parquet(out), again)
 
 
+#: A sweep's finished runs in its runs' folder: not the hidden temporary of a write the kill cut
+#: short (`collidium.io.atomic.replacing`), which may be empty.
+RUN_FILES = "[!.]*.json"
+
+
 def test_a_killed_sweep_keeps_its_finished_runs_and_resumes(tmp_path):
     """kill -9 of the whole sweep (its workers too) once runs have finished: they are in the
     runs' folder, and the sweep started again runs only the others."""
@@ -93,13 +98,13 @@ def test_a_killed_sweep_keeps_its_finished_runs_and_resumes(tmp_path):
     folder = tmp_path / "r.parquet.runs"
     try:
         deadline = time.monotonic() + 120
-        while len(list(folder.glob("*.json"))) < 2 and time.monotonic() < deadline:
+        while len(list(folder.glob(RUN_FILES))) < 2 and time.monotonic() < deadline:
             time.sleep(0.01)
     finally:
         os.killpg(process.pid, signal.SIGKILL)
         process.wait()
     kept = {json.loads(p.read_text())["key"]: json.loads(p.read_text()) for p in
-            folder.glob("*.json")}  # fmt: skip
+            folder.glob(RUN_FILES)}  # fmt: skip
     assert len(kept) >= 2 and not (tmp_path / "r.parquet").exists()
     result = collidium(*command[3:], cwd=tmp_path)
     assert result.returncode == 0, result.stderr

@@ -400,7 +400,8 @@ class _Store:
             for row in _read_table(self.table).to_dict("records"):
                 rows[str(row["key"])] = row
         if self.folder is not None and self.folder.is_dir():
-            for path in sorted(self.folder.glob("*.json")):
+            # Not the hidden temporaries of a write cut short (`replacing`): half a row.
+            for path in sorted(self.folder.glob("[!.]*.json")):
                 try:
                     row = json.loads(path.read_text(encoding="utf-8"))
                 except (OSError, ValueError):  # cut short by a kill: run again
