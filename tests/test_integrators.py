@@ -163,16 +163,22 @@ def test_substeps_follow_the_dynamics():
     assert min(counts) <= 4 and max(counts) >= 256
 
 
-def test_checkpoint_resumes_bitwise(tmp_path):
-    whole = cd.load("bohr-atom").run(time=1.0)
-    part = cd.load("bohr-atom").run(time=0.5)
+@pytest.mark.parametrize(("name", "time"), [("bohr-atom", 1.0), ("drag", 4.0),
+                                          ("spectrometer", 10.0)])  # fmt: skip
+def test_checkpoint_resumes_bitwise(tmp_path, name, time):
+    """Charges, a drag (its heat kept in the tally) and ions in a magnetic field that land on
+    the floor: resumed half-way, the run ends bit for bit as the uninterrupted one."""
+    whole = cd.load(name).run(time=time)
+    part = cd.load(name).run(time=0.5 * time)
     part.save(tmp_path / "run.ckpt")
     resumed = cd.restore(tmp_path / "run.ckpt")
     assert resumed.integrator == "adaptive" and resumed.tolerance == DEFAULT_TOLERANCE
-    resumed.run(time=0.5)
+    resumed.run(time=0.5 * time)
     np.testing.assert_array_equal(resumed.particles.position, whole.particles.position)
     np.testing.assert_array_equal(resumed.particles.velocity, whole.particles.velocity)
     assert resumed.counters == whole.counters
+    assert resumed.force_heat() == whole.force_heat()
+    assert (whole.force_heat() < 0.0) == (name == "drag")
 
 
 def test_results_do_not_depend_on_the_number_of_threads():
