@@ -610,9 +610,10 @@ class _SmoothFlight:
     """A scene's part in the compiled contact-free substeps (`collidium.kernels.substeps`): the
     vessel and forces it was made for, copies of the masses, radii and charges, the forces as
     the substeps take them (`ForceField.compiled`: the pair force's sources, coupling and
-    squared softening, a uniform field's forces, a magnetic field's frequencies and region), and
-    the walls as the exact engine has them. The integrator keeps it while it `fits`: making it
-    is most of the Python work of a small scene's reporting interval."""
+    squared softening, a uniform field's forces and carried fall, a magnetic field's frequencies
+    and region, a drag's rates), and the walls as the exact engine has them. The integrator
+    keeps it while it `fits`: making it is most of the Python work of a small scene's reporting
+    interval."""
 
     vessel: Vessel
     field: ForceField
