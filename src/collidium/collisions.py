@@ -672,9 +672,9 @@ class ExactCollisions:
         fall: FloatArray,
     ) -> int:
         """Steps in one compiled call (`Drift.fly`,
-        `collidium.kernels.event_flights.event_intervals`). With a piston, only where no
-        observer reads the record: it holds no piston, and the vessel changes as it moves."""
-        if not self.flies(particles, tally, fall) or (tally.piston.size and record.wanted.any()):
+        `collidium.kernels.event_flights.event_intervals`). The record holds no piston: with
+        one, the simulation asks for no step of it (`Simulation._reads_state`)."""
+        if not self.flies(particles, tally, fall):
             return 0
         s = self._state
         assert s is not None

@@ -428,11 +428,11 @@ class Simulation:
         """Steps, up to ``left`` and `MOST_FLOWN`, until an observer reads the state: one unless
         the integrator can fly here and every trigger is `foreseeable`. Those that read no more
         than a flight records (``take_flown``, `collidium.observers.Flown`) do not count once
-        they have started (`_reads_state`)."""
+        they have started, unless the vessel has a piston (`_reads_state`)."""
         run = min(left, MOST_FLOWN)
         if not all(foreseeable(observer.trigger) for observer in self.observers):
             return 1
-        readers = [o.trigger for o in self.observers if _reads_state(o)]
+        readers = [o.trigger for o in self.observers if self._reads_state(o)]
         for trigger in readers:  # the cheap ones first
             if isinstance(trigger, Every):
                 run = min(run, trigger.period - self.steps % trigger.period)
@@ -466,6 +466,18 @@ class Simulation:
         steps = np.arange(first + 1, first + count + 1)
         return steps, np.asarray(origin + (steps - start) * self.dt, dtype=np.float64)
 
+    def _reads_state(self, observer: Observer) -> bool:
+        """Whether ``observer`` reads more of the state than a flight records: it has no
+        ``take_flown``, or it is a measurement yet to start its window (its first sample, under
+        an `After` trigger, also reads what stays fixed over the window, and the energy it
+        starts from), or the vessel has a piston (the record holds none, and the vessel changes
+        as it moves: a flight then stops at every observer's firing)."""
+        return (
+            not hasattr(observer, "take_flown")
+            or not getattr(observer, "sampled", True)
+            or self.tally.piston.size > 0
+        )
+
     def _fly(self, run: int) -> int:
         """Up to ``run`` steps in one compiled call; the observers that read no more than its
         record get what they would have read on each step they fire on, and after the last
@@ -473,9 +485,9 @@ class Simulation:
         first = self.steps
         origin, start = self._time_origin
         steps, times = self._steps_ahead(first, run)
-        readers = [observer for observer in self.observers if _reads_state(observer)]
+        readers = [observer for observer in self.observers if self._reads_state(observer)]
         takers = [(observer, fires_at(observer.trigger, steps, times, self.dt))
-                  for observer in self.observers if not _reads_state(observer)]  # fmt: skip
+                  for observer in self.observers if not self._reads_state(observer)]  # fmt: skip
         wanted = np.zeros(run, dtype=bool)
         for _, fires in takers:
             wanted |= fires
@@ -719,14 +731,6 @@ class Simulation:
             f"Simulation({self.name!r}, n={self.particles.n}, {self.container!r}, "
             f"collisions={self.collisions!r}, dt={self.dt}, time={self.time:.6g})"
         )
-
-
-def _reads_state(observer: Observer) -> bool:
-    """Whether ``observer`` reads more of the state than a flight records: it has no
-    ``take_flown``, or it is a measurement yet to start its window (its first sample, under an
-    `After` trigger, also reads what stays fixed over the window, and the energy it starts
-    from)."""
-    return not hasattr(observer, "take_flown") or not getattr(observer, "sampled", True)
 
 
 def restore(path: str | Path) -> Simulation:
