@@ -180,13 +180,14 @@ def smooth_intervals(
     work = _work(mass, source)
     walls = (shape, half_width, half_height, rim, segments)
     external = (uniform, fall, turn, region, damp)
+    flows2 = _flows2(turn, damp)
     start = np.empty((3, n, 2))
     sources = work[3:12]
     energy, virial = _energies(position, coupling, softening2, uniform, sources)
     for k in range(count):
         now = origin + (elapsed + k) * dt
         total = kinetic_energy(mass, velocity) + energy
-        rate2 = _squared_rate(position, velocity, mass, coupling, softening2, turn, damp, total,
+        rate2 = _squared_rate(position, velocity, mass, coupling, softening2, flows2, total,
                               energy_floor, sources)  # fmt: skip
         if not dt * math.sqrt(rate2) <= most_substeps * tolerance:  # also NaN
             return k, substeps
@@ -273,8 +274,9 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     uniform, fall, turn, region, damp = external
     n = position.shape[0]
     given = 0.0
+    flows2 = _flows2(turn, damp)
     if fastest < 0.0:
-        fastest = _squared_rate(position, velocity, mass, coupling, softening2, turn, damp, total,
+        fastest = _squared_rate(position, velocity, mass, coupling, softening2, flows2, total,
                                 energy_floor, work[3:12])  # fmt: skip
     for s in range(first, count + 1):
         end = now + dt * s / count
@@ -308,7 +310,7 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
             after += heat
         given += before + after
         t = end
-        rate2 = _rate(position, velocity, mass, coupling, softening2, turn, damp, total + given,
+        rate2 = _rate(position, velocity, mass, coupling, softening2, flows2, total + given,
                       energy_floor, index, charged, inverse_mass, x, y, vx, vy)  # fmt: skip
         if rate2 > fastest:
             fastest = rate2
@@ -407,24 +409,22 @@ def _energies(position, coupling, softening2, uniform, sources) -> tuple[float, 
 
 
 @uncounted(error_model="numpy")
-def _squared_rate(position, velocity, mass, coupling, softening2, turn, damp, total, floor,
+def _squared_rate(position, velocity, mass, coupling, softening2, flows2, total, floor,
                   sources) -> float:  # fmt: skip
     """`_rate` with the arrays of `_work` from the indices to the sums' buffer (``sources``)."""
     index, charged, inverse_mass, x, y, vx, vy, _, _ = sources
-    return _rate(position, velocity, mass, coupling, softening2, turn, damp, total, floor, index,
+    return _rate(position, velocity, mass, coupling, softening2, flows2, total, floor, index,
                  charged, inverse_mass, x, y, vx, vy)  # fmt: skip
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")  # that of the inlined rows
-def _rate(position, velocity, mass, coupling, softening2, turn, damp, total, floor, index,
+def _rate(position, velocity, mass, coupling, softening2, flows2, total, floor, index,
           charged, inverse_mass, x, y, vx, vy) -> float:  # fmt: skip
     """`collidium.integrators._squared_rate`, 1/s^2, given the total energy (J): the square
     root of the largest ``(|U_ij| rate_ij^2)^2`` over pairs
     (`collidium.kernels.pairwise.inverse_distance_stiffness`, by its rows, from the particles
-    with a source ``index`` gathered into ``x, y, vx, vy``) over the energy scale, or the
-    square of the fastest rate of the velocity forces (the cyclotron frequencies ``turn``,
-    inside the field's region or not, and the damping rates ``damp``, as their forces' `rate`
-    gives them), whichever is larger."""
+    with a source ``index`` gathered into ``x, y, vx, vy``) over the energy scale, or
+    ``flows2``, the velocity forces' (`_flows2`), whichever is larger."""
     for c in range(index.shape[0]):
         i = index[c]
         x[c], y[c] = position[i, 0], position[i, 1]
@@ -436,12 +436,20 @@ def _rate(position, velocity, mass, coupling, softening2, turn, damp, total, flo
         stiffness = larger(stiffness, row)
     scale = energy_scale(kinetic_energy(mass, velocity), total, floor)
     energy = math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
+    return max(energy, flows2)
+
+
+@numba.njit(cache=True, inline="always")
+def _flows2(turn, damp) -> float:
+    """The square of the velocity forces' fastest rate, 1/s^2: of the cyclotron frequencies
+    ``turn`` (inside the field's region or not) and the damping rates ``damp``, as their forces'
+    `rate` gives them. It depends on the particles' masses and charges alone: once a call."""
     fastest = 0.0
     for i in range(turn.shape[0]):
         fastest = max(fastest, abs(turn[i]))
     for i in range(damp.shape[0]):
         fastest = max(fastest, damp[i])
-    return max(energy, fastest * fastest)
+    return fastest * fastest
 
 
 @numba.njit(cache=True, inline="always")
