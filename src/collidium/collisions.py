@@ -15,7 +15,6 @@ to a `Tally`.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Literal, Protocol
 
@@ -135,25 +134,41 @@ class FlightRecord:
         self.heat[:steps] = tally.heat
 
 
-@dataclass(frozen=True)
-class Contact:
-    """A collision or wall hit at which a drift halted, before processing it.
+class ContactLog:
+    """The contacts a drift under forces met, for the integrator's correction of their kick
+    timing (`collidium.kernels.kick_timing`).
 
     Attributes
     ----------
-    time : float
-        When the contact happens on the drift's straight paths, in s (absolute).
-    particle : int
-        Index of a particle in it.
-    partner : int
-        The other particle's index (>= 0), or ``-1 - contact`` for a contact with the vessel
-        (`collidium.kernels.vessels.contacts`: the box's wall 0 left, 1 right, 2 bottom, 3 top;
-        the rim; a segment).
+    rows : ndarray, shape (K, `collidium.kernels.events.LOG_COLUMNS`)
+        One row per contact in the order they happened: the particle, its partner (or ``-1 -
+        wall``), the time (s), the contact normal (m) and the response's ``1 + e``
+        (`collidium.kernels.events.run_events`).
+    count : ndarray of int64, shape (1,)
+        Contacts met since the last `clear`; more than K when they did not all fit.
     """
 
-    time: float
-    particle: int
-    partner: int
+    def __init__(self, capacity: int = 64) -> None:
+        self.rows = np.empty((capacity, events.LOG_COLUMNS))
+        self.count = np.zeros(1, dtype=np.int64)
+
+    def clear(self) -> None:
+        """Forget the contacts logged."""
+        self.count[0] = 0
+
+    @property
+    def complete(self) -> bool:
+        """Whether every contact since the last `clear` found a row."""
+        return int(self.count[0]) <= self.rows.shape[0]
+
+    def make_room(self) -> None:
+        """Rows for twice as many contacts as were met (a drift taken again logs them all)."""
+        self.rows = np.empty((2 * int(self.count[0]), events.LOG_COLUMNS))
+
+    @property
+    def contacts(self) -> FloatArray:
+        """The rows of the contacts logged."""
+        return self.rows[: min(int(self.count[0]), self.rows.shape[0])]
 
 
 class Drift(Protocol):
@@ -177,21 +192,17 @@ class Drift(Protocol):
         dt: float,
         tally: Tally,
         acceleration: FloatArray | None = None,
-        halt_after: float = math.inf,
         fall: FloatArray | None = None,
-    ) -> Contact | None:
+        log: ContactLog | None = None,
+    ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place, adding to ``tally``.
 
         ``acceleration`` (N, 2), in m/s^2, is that of the step's half kicks when forces act; a mode
         may use it to time collisions within the step consistently with the kicks. ``fall``
         (2,), in m/s^2, is the acceleration every particle flies under between kicks (zero for
-        a mode that does not `carries_fall`).
-
-        A mode with exact contact times stops at the first wall hit of a particle with a
-        non-zero acceleration, or collision of two with different accelerations, after
-        ``halt_after`` (s) and returns it, leaving
-        ``particles`` and ``tally`` part-way (the caller restores them); other modes, and every
-        mode when nothing halts it, return None.
+        a mode that does not `carries_fall`). A mode with exact contact times adds each contact
+        to ``log`` (with ``acceleration`` given), for the integrator to correct its kick timing
+        further; other modes leave it as it is.
         """
 
     def flies(self, particles: Particles, tally: Tally, fall: FloatArray) -> bool:
@@ -332,10 +343,10 @@ class NoCollisions(_Stateless):
         dt: float,
         tally: Tally,
         acceleration: FloatArray | None = None,
-        halt_after: float = math.inf,
         fall: FloatArray | None = None,
+        log: ContactLog | None = None,
     ) -> None:
-        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place (never halts)."""
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place (logs no contact)."""
         _free_flight(particles, vessel, dt, tally)
 
 
@@ -436,10 +447,10 @@ class StepCollisions(_Stateless):
         dt: float,
         tally: Tally,
         acceleration: FloatArray | None = None,
-        halt_after: float = math.inf,
         fall: FloatArray | None = None,
+        log: ContactLog | None = None,
     ) -> None:
-        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place (never halts)."""
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place (logs no contact)."""
         _free_flight(particles, vessel, dt, tally)
         if particles.n == 0:
             return
@@ -499,7 +510,8 @@ class ExactCollisions:
         self.rebuilds = 0
         #: Events per particle between re-sorts of the engine's memory by cell (speed only).
         self.sort_interval = events.SORT_INTERVAL
-        self._halt = np.full(events.HALT_SIZE, math.inf)
+        #: The contact log of drifts that are given none (never written: no forces).
+        self._unlogged = ContactLog(0)
         #: Where a flight leaves the piston's face (`Tally.piston`'s two values).
         self._piston_now = np.zeros(2)
 
@@ -601,11 +613,11 @@ class ExactCollisions:
         dt: float,
         tally: Tally,
         acceleration: FloatArray | None = None,
-        halt_after: float = math.inf,
         fall: FloatArray | None = None,
-    ) -> Contact | None:
-        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place, or halt before the first
-        contact of forced particles after ``halt_after`` (s) and return it (`Drift.drift`)."""
+        log: ContactLog | None = None,
+    ) -> None:
+        """Move ``particles`` from ``now`` to ``now + dt`` (s), in place, logging the contacts
+        under forces (`Drift.drift`)."""
         fall = _NO_FALL if fall is None else fall
         _refuse_runaway(particles, vessel, dt, fall)
         if not self._is_current(particles, tally.piston, fall):
@@ -614,14 +626,13 @@ class ExactCollisions:
         s = self._state
         assert s is not None
         until = now + dt
-        halt = self._halt
-        halt[events.HALT_AFTER] = halt_after
+        log = self._unlogged if log is None or acceleration is None else log
         processed = events.run_events(
             until, s["body"], particles.image, s["geometry"], s["grid"], s["head"], s["next"],
             s["event"], s["keys"], s["items"], tally.counts, tally.impulse,
             _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
-            max(1, self.sort_interval * particles.n), halt, vessel.wall_table(), tally.heat,
-            vessel.segments(), s["piston"],
+            max(1, self.sort_interval * particles.n), log.rows, log.count, vessel.wall_table(),
+            tally.heat, vessel.segments(), s["piston"],
         )  # fmt: skip
         if processed < 0:
             self._state = None  # the queue is unusable; a later drift rebuilds it
@@ -632,14 +643,6 @@ class ExactCollisions:
                 "step's start); the state has run away: try a smaller dt or softening"
             )
         self.events += processed
-        if not math.isnan(halt[events.HALT_TIME]):
-            # Part-way through the drift: rebuilt from the restored particles, in these arrays.
-            self._spare, self._state = self._state, None
-            return Contact(
-                float(halt[events.HALT_TIME]),
-                int(halt[events.HALT_PARTICLE]),
-                int(halt[events.HALT_PARTNER]),
-            )
         strays = events.synchronise(
             until, s["body"], s["event"], s["geometry"], s["grid"], particles.position,
             particles.velocity,
@@ -649,7 +652,6 @@ class ExactCollisions:
         if strays and s["grid"][2] == 0 and not _window_is_vessel(s["geometry"], s["grid"]):
             # Disks have spread out of the cells' window: a larger one at the next drift.
             self._spare, self._state = self._state, None
-        return None
 
     def flies(self, particles: Particles, tally: Tally, fall: FloatArray) -> bool:
         """Whether `fly` may take steps now: the queue is built for this ``fall``, nobody
@@ -679,7 +681,6 @@ class ExactCollisions:
         s = self._state
         assert s is not None
         before = (tally.counts.copy(), tally.impulse.copy(), tally.heat.copy())
-        self._halt[events.HALT_AFTER] = math.inf
         fall_x, fall_y = (float(g) for g in fall)
         width, height = (float(side) for side in vessel.size)
         face = vessel.piston_face()
@@ -687,8 +688,9 @@ class ExactCollisions:
         taken, processed, ending = event_flights.event_intervals(
             origin, elapsed, dt, record.values.shape[0], s["body"], p.image, s["geometry"],
             s["grid"], s["head"], s["next"], s["event"], s["keys"], s["items"], tally.counts,
-            tally.impulse, _NO_ACCELERATION, max(1, self.sort_interval * p.n), self._halt,
-            vessel.wall_table(), tally.heat, vessel.segments(), s["piston"], p.position,
+            tally.impulse, _NO_ACCELERATION, max(1, self.sort_interval * p.n),
+            self._unlogged.rows, self._unlogged.count, vessel.wall_table(), tally.heat,
+            vessel.segments(), s["piston"], p.position,
             p.velocity, writable(p.mass), writable(p.radius), fall_x, fall_y, width, height,
             _runaway_reach(vessel),
             *vessel.audit_arguments(), bool(s["grid"][2]) or _window_is_vessel(s["geometry"],

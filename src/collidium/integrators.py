@@ -3,8 +3,8 @@
 Two integrators advance the state over one reporting interval ``dt``:
 
 - `AdaptiveLeapfrog` (``"adaptive"``, the default): as many substeps inside ``dt`` as the forces
-  need, and a substep boundary at every contact of forced particles, so that collisions and wall
-  hits happen between kicks, where the elastic response is exact;
+  need, the contacts inside their drifts with the kick timing corrected to second order
+  (`collidium.kernels.kick_timing`);
 - `Leapfrog` (``"fixed"``): one kick-drift-kick step of ``dt``, the seed's scheme, kept to
   reproduce its results (energy error O(dt^2), and O(dt^2) per collision under forces).
 
@@ -28,13 +28,13 @@ from typing import Literal
 
 import numpy as np
 
-from collidium.collisions import Contact, Drift, FlightRecord, Tally
+from collidium.collisions import ContactLog, Drift, FlightRecord, Tally
 from collidium.errors import SimulationError
 from collidium.forces import ForceField
 from collidium.forces.base import CompiledForces
-from collidium.kernels import substeps, sums
+from collidium.kernels import kick_timing, substeps, sums
 from collidium.kernels.pairwise import PARALLEL_DIRECT_FROM
-from collidium.state import FloatArray, Particles
+from collidium.state import FloatArray, Particles, writable
 from collidium.vessels import Vessel
 
 IntegratorName = Literal["adaptive", "fixed"]
@@ -51,25 +51,9 @@ DEFAULT_TOLERANCE = 0.0007
 #: check of the run reports the error.
 MAX_SUBSTEPS = 2**14
 
-#: Most contacts under forces in one reporting interval: each shortens a substep and costs a force
-#: evaluation, so one more stops the run with one line (a disk at 1e8 m/s in a 20 m box hits its
-#: walls 50000 times in a dt of 0.01 s: minutes of substeps for every dt).
-MAX_CONTACTS = 2**14
-
 #: The energy scale of the substep criterion is the total energy, but at least ``KE + |U|``
 #: divided by this.
 TOTAL_ENERGY_FLOOR = 10.0
-
-#: Contacts less than this fraction of ``dt`` after a substep starts are taken inside its drift:
-#: they are the ones a substep was shortened for, now at the very start of the drift, where the
-#: engine's kick-timing correction makes the response exact; and those whose kick-drift-kick
-#: parabola meets them that soon (a disk resting on a floor under gravity), which shortened
-#: substeps would meet again and again without end.
-CONTACT_WINDOW = 1e-8
-
-#: A substep shortened for a contact ends this fraction of ``dt`` before it, so that the contact
-#: falls at the start of the next drift rather than at the end of this one.
-CONTACT_MARGIN = 1e-10
 
 
 class Integrator:
@@ -247,17 +231,20 @@ class AdaptiveLeapfrog(Integrator):
     time-symmetric within an interval, and the count of an interval depends on its neighbours
     only by that factor of two. The energy error stays bounded and scales as ``tolerance^2``.
 
-    A contact under a force (a collision or a wall hit of a particle with an acceleration) would
-    fall inside a drift, between the kicks, where the response cannot see the kick after it: the
-    substep is then shortened so that its kick-drift-kick parabola ``x + v h + a h^2 / 2`` ends
-    just at the contact, and the contact is taken at the start of the next substep's drift, with
-    synchronised velocities. A collision then costs one more force evaluation and its error is
-    that of the smooth substeps around it.
+    A contact under a force (a collision or a wall hit of a particle with an acceleration) falls
+    inside a drift, between the kicks, which put the forces' impulse at the substep's ends. The
+    engine's response takes out the first-order error of that timing, and once the forces at
+    the substep's end are known the second-order part is corrected too
+    (`collidium.kernels.kick_timing`): a contact costs no force evaluation of its own, and in a
+    charged gas its error stays below that of the smooth substeps around it. This correction is
+    the one part of the scheme that is not time-symmetric: it is exact for accelerations that
+    change linearly before and after the contact, and its error is O(h^3) per contact.
 
-    In a small scene under one direct pair force (`_SmoothFlight`), an interval that meets no
-    contact is taken whole by one compiled call (`collidium.kernels.substeps.smooth_intervals`),
-    and `fly` takes many such intervals by the same call: the simulation flies the steps between
-    the observers that read its state, bit for bit as `step` takes them one by one.
+    In a small scene under the forces the compiled substeps take (`_SmoothFlight`), an interval
+    that meets no contact is taken whole by one compiled call
+    (`collidium.kernels.substeps.smooth_intervals`), and `fly` takes many such intervals by the
+    same call: the simulation flies the steps between the observers that read its state, bit
+    for bit as `step` takes them one by one.
 
     Parameters
     ----------
@@ -276,6 +263,7 @@ class AdaptiveLeapfrog(Integrator):
         #: met a contact under forces (in a gas the next likely meets one too, and a try would
         #: cost its substeps up to the contact twice), or `fly` found that it meets one.
         self.next_in_python = False
+        self._log = ContactLog()
 
     def state(self) -> dict[str, np.ndarray]:
         """The substep count the next interval starts with, and whether it is taken in Python
@@ -411,15 +399,14 @@ class AdaptiveLeapfrog(Integrator):
         fastest: float,
         total: float,
     ) -> tuple[float, bool]:
-        """Take the interval in ``n`` regular substeps (each split at contacts), those that meet
-        no contact by the compiled ``flight`` where there is one. Returns the largest squared
-        rate (1/s^2) met at their boundaries (the regular ones: they are the same forwards and
-        backwards, and contacts come with their own substep boundaries), starting from
-        ``fastest``, the interval's start's (`_squared_rate`, with the ``total`` energy J at the
-        start and the energy given since: by the velocity forces, the walls, a piston and
-        inelastic collisions); and whether a contact shortened a substep."""
+        """Take the interval in ``n`` regular substeps, those that meet no contact by the
+        compiled ``flight`` where there is one. Returns the largest squared rate (1/s^2) met at
+        their boundaries, starting from ``fastest``, the interval's start's (`_squared_rate`,
+        with the ``total`` energy J at the start and the energy given since: by the velocity
+        forces, the walls, a piston and inelastic collisions); and whether a substep met a
+        contact."""
         t = now
-        contacts = 0
+        met = False
         given = _given(tally)
         s = 1
         while s <= n:
@@ -431,19 +418,12 @@ class AdaptiveLeapfrog(Integrator):
                 if s > n:
                     break
             end = now + dt * s / n
-            while t < end:  # substeps shortened for contacts end at a contact, not at ``end``
-                t = self._substep(particles, vessel, field, drift, t, end, dt, tally, s == n)
-                contacts += t < end
-                if contacts > MAX_CONTACTS:
-                    raise SimulationError(
-                        f"more than {MAX_CONTACTS} contacts under forces in one dt = {dt:g} s "
-                        f"at t = {now:.6g} s, each a force evaluation: try a smaller dt, or "
-                        f'collisions = "step"'
-                    )
+            met |= self._substep(particles, vessel, field, drift, t, end, tally, s == n)
+            t = end
             now_total = total + (_given(tally) - given)
             fastest = max(fastest, _squared_rate(particles, vessel, field, now_total))
             s += 1
-        return fastest, contacts > 0
+        return fastest, met
 
     def _substep(
         self,
@@ -453,40 +433,52 @@ class AdaptiveLeapfrog(Integrator):
         drift: Drift,
         t: float,
         end: float,
-        dt: float,
         tally: Tally,
         last: bool,
-    ) -> float:
-        """One kick-drift-kick from ``t`` to ``end`` (s), or to just before the first contact of
-        forced particles on the way; returns the time reached. It closes the step if it reaches
-        ``end`` and that is the interval's (``last``).
-
-        A contact that the kick-drift-kick parabola puts within `CONTACT_WINDOW` of the start
-        (a disk resting on a floor under gravity, which a shortened substep would meet again
-        and again) is taken inside the drift, and the next one is looked for."""
-        before = _Snapshot(particles, tally)
+    ) -> bool:
+        """One kick-drift-kick from ``t`` to ``end`` (s), its contacts inside the drift, their
+        kick timing corrected (`_corrected`); it closes the step if it is the interval's
+        (``last``). Returns whether it met a contact."""
         h = end - t
-        acceleration = field.acceleration
-        fall = field.fall
-        halt_after = t + CONTACT_WINDOW * dt
-        reached = end
+        before = _Snapshot(particles, tally)
+        acceleration = field.acceleration.copy()
+        log = self._log
         while True:
+            log.clear()
             _kick(particles, vessel, field, h, tally)
-            contact = drift.drift(particles, vessel, t, h, tally, acceleration, halt_after, fall)
-            if contact is None:
+            drift.drift(particles, vessel, t, h, tally, field.acceleration, field.fall, log)
+            if log.complete:
                 break
-            before.restore(particles, tally)
-            # From the velocities before the velocity forces' half: they turn a velocity by
-            # at most ``tolerance`` in it, within the margin the drift takes contacts in.
-            shortened = _shortened(particles, vessel, acceleration + fall, contact, t, h, dt)
-            if shortened > CONTACT_WINDOW * dt:
-                h, reached = shortened, t + shortened
-                _kick(particles, vessel, field, h, tally)
-                drift.drift(particles, vessel, t, h, tally, acceleration, fall=fall)
-                break
-            halt_after = contact.time
-        _closing_kick(particles, vessel, field, h, tally, closes_step=last and reached == end)
-        return reached
+            before.restore(particles, tally)  # with room for all, taken again
+            log.make_room()
+
+        def corrected(after: FloatArray) -> None:
+            _corrected(log, particles, vessel, field, t, h, before.position, acceleration, after)
+
+        _closing_kick(particles, vessel, field, h, tally, last, corrected if log.count[0] else None)
+        return bool(log.count[0])
+
+
+def _corrected(
+    log: ContactLog,
+    particles: Particles,
+    vessel: Vessel,
+    field: ForceField,
+    t: float,
+    h: float,
+    start: FloatArray,
+    before: FloatArray,
+    after: FloatArray,
+) -> None:
+    """The second-order correction of the kick timing of the contacts in ``log``, met in the
+    substep of ``h`` s from ``t`` (s) that started at positions ``start`` under the accelerations
+    ``before`` and ends under ``after`` (`collidium.kernels.kick_timing`), on the velocities
+    before the closing kick."""
+    width, height = (float(side) for side in vessel.size)
+    kick_timing.correct(
+        log.contacts, t, h, start, particles.position, before, after, particles.velocity,
+        writable(particles.mass), *field.pair_laws(particles), width, height, vessel.periodic,
+    )  # fmt: skip
 
 
 def _kick(particles: Particles, vessel: Vessel, field: ForceField, h: float, tally: Tally) -> None:
@@ -503,11 +495,15 @@ def _closing_kick(
     h: float,
     tally: Tally,
     closes_step: bool = False,
+    correction: Callable[[FloatArray], None] | None = None,
 ) -> None:
     """What comes after the drift, in the mirror order of `_kick`: the forces at the new
-    positions (their evaluation `closes_step` or not: `ForceField.evaluate`), their kick
-    ``a h / 2``, then the velocity forces for ``h / 2``."""
-    particles.velocity += (0.5 * h) * field.evaluate(particles, vessel, closes_step)
+    positions (their evaluation `closes_step` or not: `ForceField.evaluate`), the ``correction``
+    that needs them if any, their kick ``a h / 2``, then the velocity forces for ``h / 2``."""
+    after = field.evaluate(particles, vessel, closes_step)
+    if correction is not None:
+        correction(after)
+    particles.velocity += (0.5 * h) * after
     tally.forces[0] += field.advance(particles, vessel, 0.5 * h, first=False)
 
 
@@ -529,72 +525,6 @@ def _squared_rate(particles: Particles, vessel: Vessel, field: ForceField, total
     scale = substeps.energy_scale(kinetic, total, TOTAL_ENERGY_FLOOR)
     energy = math.sqrt(field.stiffness(particles, vessel)) / scale if scale > 0.0 else 0.0
     return max(energy, field.rate(particles, vessel) ** 2)
-
-
-def _shortened(
-    particles: Particles,
-    vessel: Vessel,
-    acceleration: FloatArray,
-    contact: Contact,
-    t: float,
-    h: float,
-    dt: float,
-) -> float:
-    """The substep (s) whose kick-drift-kick parabola ends just before ``contact``.
-
-    The drift after a kick ``a h / 2`` follows ``x + v h + a h^2 / 2`` at its end (``a`` with
-    the fall the drift carries), so the contact
-    time is a root of ``|r + w h + b h^2 / 2| = sigma`` for a pair (relative position, velocity
-    and acceleration) or the vessel's `Vessel.wall_gap` for a wall, found by Newton's method
-    from the straight-path time the drift found. If that fails, the straight-path time is used.
-    """
-    straight = contact.time - t
-    i, j = contact.particle, contact.partner
-    x, v, a = particles.position, particles.velocity, acceleration
-    if j >= 0:
-        gap = _pair_gap(particles, vessel, acceleration, i, j)
-    else:
-        gap = vessel.wall_gap(-1 - j, x[i], v[i], a[i], float(particles.radius[i]))
-    root = _newton(gap, straight)
-    if not (math.isfinite(root) and 0.0 < root <= h):
-        root = straight
-    return max(root - CONTACT_MARGIN * dt, 0.5 * root)
-
-
-def _pair_gap(
-    particles: Particles, vessel: Vessel, acceleration: FloatArray, i: int, j: int
-) -> Callable[[float], tuple[float, float]]:
-    """``s -> (|r(s)|^2 - sigma^2, its derivative)`` for the pair (i, j) on their kick-drift-kick
-    parabolas, ``r(s) = r + w s + b s^2 / 2`` (relative position, velocity, acceleration)."""
-    x, v, a = particles.position, particles.velocity, acceleration
-    # Plain floats: a handful of Newton steps on scalars.
-    rx, ry = (float(c) for c in vessel.minimum_image(x[i] - x[j]))
-    wx, wy = float(v[i, 0] - v[j, 0]), float(v[i, 1] - v[j, 1])
-    bx, by = float(a[i, 0] - a[j, 0]), float(a[i, 1] - a[j, 1])
-    sigma = float(particles.radius[i] + particles.radius[j])
-
-    def gap(s: float) -> tuple[float, float]:
-        dx, dy = rx + (wx + 0.5 * bx * s) * s, ry + (wy + 0.5 * by * s) * s
-        slope = 2.0 * (dx * (wx + bx * s) + dy * (wy + by * s))
-        return dx * dx + dy * dy - sigma * sigma, slope
-
-    return gap
-
-
-def _newton(
-    function: Callable[[float], tuple[float, float]], guess: float, iterations: int = 30
-) -> float:
-    """A root of ``function(s) -> (value, derivative)`` from ``guess`` (NaN if none is found)."""
-    s = guess
-    for _ in range(iterations):
-        value, slope = function(s)
-        if slope == 0.0 or not math.isfinite(value):
-            return math.nan
-        step = value / slope
-        s -= step
-        if abs(step) <= 1e-15 * abs(s):
-            return s
-    return s if math.isfinite(s) else math.nan
 
 
 #: The forces as the compiled substeps' arguments: the pair force's sources, coupling and squared

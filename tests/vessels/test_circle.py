@@ -125,7 +125,8 @@ def test_checkpoints_in_a_circle_resume_bitwise(tmp_path):
 
 @pytest.mark.slow
 def test_a_charged_gas_in_a_circle_holds_its_energy():
-    """Contacts of forced disks with the rim fall between substeps too (`Vessel.wall_gap`)."""
+    """Contacts of forced disks with the rim have their kick timing corrected too
+    (`collidium.kernels.kick_timing`: the rim's outward normal)."""
     data = gas(n=60, speed=5.0).to_dict()
     data["particles"][0] |= {"charge": 1.0, "charges": "balanced"}
     data["forces"] = [{"type": "coulomb", "k": 5.0}]

@@ -229,8 +229,8 @@ def test_checkpoints_in_a_polygon_resume_bitwise(tmp_path):
 
 @pytest.mark.slow
 def test_a_charged_gas_in_an_l_holds_its_energy():
-    """Contacts of forced disks with edges and corners fall between substeps too
-    (`Vessel.wall_gap` for segments)."""
+    """Contacts of forced disks with edges and corners have their kick timing corrected too
+    (`collidium.kernels.kick_timing`: the segment's normal at the contact)."""
     data = gas(L_SHAPE, n=40, speed=5.0).to_dict()
     data["particles"][0] |= {"charge": 1.0, "charges": "balanced"}
     data["forces"] = [{"type": "coulomb", "k": 5.0}]

@@ -108,6 +108,16 @@ class DirectPairForce(PositionForce, Protocol):
 
 
 @runtime_checkable
+class PairLawForce(PositionForce, Protocol):
+    """A position force between pairs of particles by an inverse-distance law, however it is
+    summed: what the kick timing of their contacts needs (`collidium.kernels.kick_timing`)."""
+
+    def pair_law(self, particles: Particles) -> tuple[FloatArray, float, float]:
+        """``(sources (N,), coupling, squared softening in m^2)`` of the law
+        ``U_ij = c s_i s_j / sqrt(r^2 + eps^2)`` (`collidium.kernels.pairwise`)."""
+
+
+@runtime_checkable
 class UniformPositionForce(PositionForce, Protocol):
     """A position force that is a constant force on each particle (a uniform field), which the
     compiled substeps can kick with (`collidium.kernels.substeps`)."""
@@ -374,6 +384,7 @@ class ForceField:
         #: The forces by the part the compiled substeps give them (`compiled`; a protocol
         #: check is slow), or None where a force is none of those parts.
         self._compiled = _CompiledParts.of(self._position, self._velocity, self._carried)
+        self._pair_laws = tuple(f for f in self._position if isinstance(f, PairLawForce))
         self._fall = np.zeros(2)
         for force, carried in zip(self._position, self._carried, strict=True):
             if carried:
@@ -485,6 +496,15 @@ class ForceField:
             _WHOLE_PLANE if turning is None else turning.bounds(),
             np.empty(0) if damping is None else damping.damping(particles),
         )
+
+    def pair_laws(self, particles: Particles) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The inverse-distance pair forces' laws (`PairLawForce.pair_law`): their sources
+        (L, N), couplings (L,) and squared softenings (L,), m^2."""
+        laws = [force.pair_law(particles) for force in self._pair_laws]
+        sources = np.array([law[0] for law in laws]).reshape(len(laws), particles.n)
+        couplings = np.array([law[1] for law in laws], dtype=float)
+        softenings2 = np.array([law[2] for law in laws], dtype=float)
+        return sources, couplings, softenings2
 
     def stiffness(self, particles: Particles, vessel: Vessel) -> float:
         """``S`` of all forces at the current state, in J^2/s^4: the largest of the forces'

@@ -188,6 +188,11 @@ class InverseDistanceForce:
             particles, vessel, acceleration,
         )  # fmt: skip
 
+    def pair_law(self, particles: Particles) -> tuple[FloatArray, float, float]:
+        """The sources, coupling and squared softening of the law
+        (`collidium.forces.base.PairLawForce`)."""
+        return getattr(particles, self.source), self.coupling, self.softening**2
+
     def direct_term(self, particles: Particles, vessel: Vessel) -> tuple[str, float, float] | None:
         """The sources' property, coupling and squared softening when the sum is direct and
         not periodic (`collidium.forces.base.DirectPairForce`)."""

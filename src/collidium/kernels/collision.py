@@ -48,12 +48,20 @@ def pair_response(
     n2 = nx * nx + ny * ny
     along = ((v1x - v2x) * nx + (v1y - v2y) * ny) / n2
     total = m1 + m2
-    bounce = 2.0
-    if restitution != 1.0 and -along * math.sqrt(n2) > elastic_below:
-        bounce = 1.0 + restitution
+    bounce = bounce_factor(along, n2, restitution, elastic_below)
     f1 = bounce * m2 / total * along
     f2 = bounce * m1 / total * along
     return v1x - f1 * nx, v1y - f1 * ny, v2x + f2 * nx, v2y + f2 * ny
+
+
+@inlined
+def bounce_factor(along: float, n2: float, restitution: float, elastic_below: float) -> float:
+    """``1 + e`` of a collision whose normal relative velocity is ``along`` times the line of
+    centres of squared length ``n2`` (m^2): the normal relative velocity changes by that factor
+    times itself, 2 when elastic (`pair_response`)."""
+    if restitution != 1.0 and -along * math.sqrt(n2) > elastic_below:
+        return 1.0 + restitution
+    return 2.0
 
 
 @inlined

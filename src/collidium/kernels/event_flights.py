@@ -32,7 +32,7 @@ ALL, STOPPED, OUT_OF_WINDOW = range(3)
 @uncounted()
 def event_intervals(
     origin, elapsed, dt, count, body, image, geometry, grid, head, next_, event, keys, items,
-    tally, impulse, acceleration, sort_every, halt, walls, heat, segments, piston, position,
+    tally, impulse, acceleration, sort_every, log, logged, walls, heat, segments, piston, position,
     velocity, mass, radius, fall_x, fall_y, width, height, reach, audit_shape, limit_x, limit_y,
     slack, periodic, window_is_vessel, piston_allowance, piston_now, record, counts, impulses,
     heats, wanted,
@@ -48,8 +48,8 @@ def event_intervals(
         The clock's origin (s), the steps from it to the first step's start, the step (s) and
         the most steps to take (at most ``len(record)``).
     body, image, geometry, grid, head, next_, event, keys, items, tally, impulse, acceleration,
-    sort_every, halt, walls, heat, segments, piston
-        As `events.run_events` takes them (``acceleration`` empty, ``halt`` never halting).
+    sort_every, log, logged, walls, heat, segments, piston
+        As `events.run_events` takes them (``acceleration`` empty: nothing is logged).
     position, velocity : ndarray, shape (N, 2)
         The particles' state (m, m/s), written at each step's end (`events.synchronise`).
     mass, radius : ndarray, shape (N,)
@@ -98,7 +98,8 @@ def event_intervals(
         until = now + dt
         done = events.run_events(until, body, image, geometry, grid, head, next_, event, keys,
                                  items, tally, impulse, acceleration, now + 0.5 * dt,
-                                 sort_every, halt, walls, heat, segments, piston)  # fmt: skip
+                                 sort_every, log, logged, walls, heat, segments,
+                                 piston)  # fmt: skip
         if done < 0:
             return k, processed, done
         processed += done

@@ -50,7 +50,7 @@ import numpy as np
 
 from collidium.kernels import parabolas, wall_responses
 from collidium.kernels.cells import cell_index, neighbour_cell
-from collidium.kernels.collision import energy_change, pair_response
+from collidium.kernels.collision import bounce_factor, energy_change, pair_response
 from collidium.kernels.compilation import inlined, uncounted
 from collidium.kernels.vessels import BOX, contacts
 from collidium.kernels.vessels import piston as pistons
@@ -85,10 +85,13 @@ EVENT_COLUMNS = 3
 IDENT, CELL, COUNT, WHERE = range(EVENT_COLUMNS, EVENT_COLUMNS + 4)
 SLOT_COLUMNS = EVENT_COLUMNS + 4
 
-#: Entries of the ``halt`` array of `run_events`: in, the time after which a contact of forced
-#: particles halts the drift; out, that contact's time, particle and partner (or ``-1 - wall``).
-HALT_AFTER, HALT_TIME, HALT_PARTICLE, HALT_PARTNER = range(4)
-HALT_SIZE = 4
+#: Columns of the contact log that `run_events` writes in a drift under forces: the particle, its
+#: partner (or ``-1 - wall``, `collidium.vessels.Vessel.wall_names` order), the time (s), the
+#: contact normal (the line of centres ``x_i - x_j``, or the wall's outward unit normal, m), and
+#: the factor by which the response changed the normal velocity, ``1 + e`` (0 where the kick-timing
+#: correction was not applied: a wall that is not a mirror, a piston, a pair still approaching).
+LOG_PARTICLE, LOG_PARTNER, LOG_TIME, LOG_NX, LOG_NY, LOG_BOUNCE = range(6)
+LOG_COLUMNS = 6
 
 #: Children per node of the event queue's heap: 8 keys fill one 64-byte line, and the heap is a
 #: third as deep as a binary one.
@@ -662,7 +665,8 @@ def run_events(
     acceleration: np.ndarray,
     midpoint: float,
     sort_every: int,
-    halt: np.ndarray,
+    log: np.ndarray,
+    logged: np.ndarray,
     walls: np.ndarray,
     heat: np.ndarray,
     segments: np.ndarray,
@@ -687,16 +691,12 @@ def run_events(
     sort_every : int
         Events between two re-sorts of the slots (`sort_slots`); the outcome does not depend on
         it, only the speed.
-    halt : ndarray of float64, shape (4,)
-        ``halt[HALT_AFTER]`` (s): a wall hit later than this time of a particle with a non-zero
-        ``acceleration``, or a collision of two with different ones (`_halts`), stops the drift
-        before it is processed; its
-        time and particles go to ``halt[HALT_TIME]``, ``halt[HALT_PARTICLE]`` and
-        ``halt[HALT_PARTNER]`` (the partner, or ``-1 - contact`` for a contact with the vessel,
-        `collidium.kernels.vessels.contacts`); ``halt[HALT_TIME]`` is NaN if
-        the drift ran to ``until``. Infinity never halts. The engine's state is then part-way
-        through the drift: the caller rebuilds it (`collidium.integrators` takes such a drift
-        again, shorter, so that the contact falls between two substeps).
+    log : ndarray of float64, shape (K, `LOG_COLUMNS`)
+        With forces (``acceleration`` not empty), each contact of the drift in turn, as long as
+        there is room (`_log_contact`), for the integrator's correction of its kick timing
+        (`collidium.kernels.kick_timing`).
+    logged : ndarray of int64, shape (1,)
+        Incremented by each contact logged, also those that found no room.
     walls : ndarray, shape (W, 3)
         The vessel's wall table (`collidium.kernels.wall_responses`): how each wall responds.
     heat : ndarray of float64, shape (1 + W,)
@@ -718,7 +718,6 @@ def run_events(
     """
     ident, cell_of, count, where = _slot_views(event)
     processed = 0
-    halt[HALT_TIME] = math.nan
     n = body.shape[0]
     if n == 0:
         return 0
@@ -742,8 +741,6 @@ def run_events(
         if t > until:
             break
         k = earliest(keys, items, ident)
-        if t > halt[HALT_AFTER] and _halts(k, t, body, ident, count, event, acceleration, halt):
-            break
         processed += 1
         since_sort += 1
         if t > instant:
@@ -759,7 +756,7 @@ def run_events(
             j = code
             if count[j] == event[k, PARTNER_COUNT]:
                 _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
-                         midpoint, heat)  # fmt: skip
+                         midpoint, heat, log, logged)  # fmt: skip
                 count[k] += 1
                 count[j] += 1
                 # Not the literal -1, which numba would compile a second `predict` for.
@@ -768,11 +765,13 @@ def run_events(
                 heap_update(j, t_j, keys, items, where)
         elif piston.shape[0] > 0 and code == FIRST_WALL_CODE - piston[pistons.WALL]:
             _push_piston(k, t, body, ident, geometry, tally, impulse, heat, piston)
+            if acceleration.shape[0] > 0:
+                _log_contact(log, logged, ident[k], -1 - piston[pistons.WALL], t, 0.0, 0.0, 0.0)
             count[k] += 1
             pushed = True
         elif code <= FIRST_WALL_CODE:
             _bounce(k, FIRST_WALL_CODE - code, t, body, ident, geometry, tally, impulse,
-                    acceleration, midpoint, walls, heat, segments)  # fmt: skip
+                    acceleration, midpoint, walls, heat, segments, log, logged)  # fmt: skip
             count[k] += 1
         elif code >= CELL_CODES[1]:
             crossed = -1 - code
@@ -830,35 +829,17 @@ def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count,
 
 
 @inlined
-def _halts(k, t, body, ident, count, event, acceleration, halt) -> bool:
-    """Whether slot k's event at time t is a contact that halts the drift (see `run_events`):
-    a wall hit of a particle with an acceleration, or a valid pair collision of two particles
-    with different accelerations. Records it. (Under the same acceleration, a uniform gravity,
-    a pair's relative motion is free flight: its contact time is exact and the response, taken
-    on velocities that differ from the true ones by the same kick, is exact as well.)"""
-    if acceleration.shape[0] == 0:
-        return False
-    code = event[k, CODE]
-    if code >= 0:
-        if count[code] != event[k, PARTNER_COUNT]:
-            return False  # stale
-        partner = ident[code]
-    elif code <= FIRST_WALL_CODE:
-        partner = -1 - (FIRST_WALL_CODE - code)
-    else:
-        return False  # a cell crossing
-    i = ident[k]
-    if partner >= 0:
-        forced = (acceleration[i, 0] != acceleration[partner, 0]
-                  or acceleration[i, 1] != acceleration[partner, 1])  # fmt: skip
-    else:
-        forced = acceleration[i, 0] != 0.0 or acceleration[i, 1] != 0.0
-    if not forced:
-        return False
-    halt[HALT_TIME] = t
-    halt[HALT_PARTICLE] = i
-    halt[HALT_PARTNER] = partner
-    return True
+def _log_contact(log, logged, particle, partner, t, nx, ny, bounce) -> None:
+    """Write a contact into the next row of ``log`` if there is one (`run_events`)."""
+    row = logged[0]
+    if row < log.shape[0]:
+        log[row, LOG_PARTICLE] = particle
+        log[row, LOG_PARTNER] = partner
+        log[row, LOG_TIME] = t
+        log[row, LOG_NX] = nx
+        log[row, LOG_NY] = ny
+        log[row, LOG_BOUNCE] = bounce
+    logged[0] = row + 1
 
 
 @inlined
@@ -869,9 +850,10 @@ def _advance(k: int, t: float, body: np.ndarray, geometry: np.ndarray) -> None:
 
 
 @inlined
-def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration, midpoint, heat):
+def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration, midpoint, heat,
+             log, logged):  # fmt: skip
     """Collision of slots k and j at time t (s); an inelastic one books the kinetic energy it
-    takes in ``heat[PAIR_COLLISIONS]`` (J, negative)."""
+    takes in ``heat[PAIR_COLLISIONS]`` (J, negative); under forces it is logged."""
     _advance(k, t, body, geometry)
     _advance(j, t, body, geometry)
     # Contact normal x_k - x_j; in contact the pair is at most half a side apart, so the
@@ -881,9 +863,11 @@ def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
     if grid[2] != 0:
         nx -= 2.0 * geometry[HALF_WIDTH] * round(nx / (2.0 * geometry[HALF_WIDTH]))
         ny -= 2.0 * geometry[HALF_HEIGHT] * round(ny / (2.0 * geometry[HALF_HEIGHT]))
-    v1x, v1y, v2x, v2y = _pair_response(
+    v1x, v1y, v2x, v2y, bounce = _pair_response(
         k, j, nx, ny, midpoint - t, body, ident, geometry, acceleration
     )
+    if acceleration.shape[0] > 0:
+        _log_contact(log, logged, ident[k], ident[j], t, nx, ny, bounce)
     m1, m2 = _mass(k, body, geometry), _mass(j, body, geometry)
     impulse[PAIR_COLLISIONS] += m1 * (nx * (v1x - body[k, VX]) + ny * (v1y - body[k, VY]))
     if geometry[RESTITUTION] != 1.0:
@@ -898,10 +882,11 @@ def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
 
 @inlined
 def _bounce(k, contact, t, body, ident, geometry, tally, impulse, acceleration, midpoint, walls,
-            heat, segments):  # fmt: skip
+            heat, segments, log, logged):  # fmt: skip
     """Slot k meets the vessel at ``contact`` (`collidium.kernels.vessels.contacts`) at time t
     (s). The disk is first snapped onto the contact line, so that round-off never leaves it past
-    the wall; then the wall responds (``walls``, the vessel's wall table)."""
+    the wall; then the wall responds (``walls``, the vessel's wall table). Under forces the hit
+    is logged."""
     _advance(k, t, body, geometry)
     r = _radius(k, body, geometry)
     m = _mass(k, body, geometry)
@@ -916,6 +901,8 @@ def _bounce(k, contact, t, body, ident, geometry, tally, impulse, acceleration, 
                                     tally, impulse, heat, WALL_HITS + wall)  # fmt: skip
         body[k, VX] = vx
         body[k, VY] = vy
+        if acceleration.shape[0] > 0:
+            _log_contact(log, logged, ident[k], -1 - wall, t, nx, ny, 0.0)
         return
     forced = acceleration.shape[0] > 0
     if geometry[SHAPE] == BOX and contact < contacts.SEGMENTS_FROM:
@@ -924,7 +911,8 @@ def _bounce(k, contact, t, body, ident, geometry, tally, impulse, acceleration, 
         sign = 1.0 if contact % 2 == 1 else -1.0
         before = body[k, VX + d]
         pull = acceleration[ident[k], d] if forced else 0.0
-        after = sign * _wall_response(sign * before, sign * pull, midpoint - t, forced)
+        normal, corrected = _wall_response(sign * before, sign * pull, midpoint - t, forced)
+        after = sign * normal
         body[k, VX + d] = after
         impulse[WALL_HITS + wall] += m * abs(after - before)
     else:
@@ -932,11 +920,14 @@ def _bounce(k, contact, t, body, ident, geometry, tally, impulse, acceleration, 
         pull = 0.0
         if forced:
             pull = acceleration[ident[k], 0] * nx + acceleration[ident[k], 1] * ny
-        change = _wall_response(outward, pull, midpoint - t, forced) - outward
+        normal, corrected = _wall_response(outward, pull, midpoint - t, forced)
+        change = normal - outward
         body[k, VX] += change * nx
         body[k, VY] += change * ny
         impulse[WALL_HITS + wall] += m * abs(change)
     tally[WALL_HITS + wall] += 1
+    if forced:
+        _log_contact(log, logged, ident[k], -1 - wall, t, nx, ny, 2.0 if corrected else 0.0)
 
 
 @inlined
@@ -950,6 +941,10 @@ def _pair_response(k, j, nx, ny, lead, body, ident, geometry, acceleration):
     and the surplus put back: ``v' = C(v - delta) + delta``. Momentum is conserved exactly; the
     error per collision becomes O(dt^2). If that would leave the pair still approaching (a slow
     contact under strong attraction), the plain response ``C(v)`` is used.
+
+    Returns the four velocity components and the factor ``1 + e`` by which the corrected
+    response changed the normal relative velocity (`collision.bounce_factor`), 0 where it was
+    not corrected (no forces, or the plain response).
     """
     m1 = _mass(k, body, geometry)
     m2 = _mass(j, body, geometry)
@@ -965,8 +960,11 @@ def _pair_response(k, j, nx, ny, lead, body, ident, geometry, acceleration):
         )
         w1x, w1y, w2x, w2y = w1x + d1x, w1y + d1y, w2x + d2x, w2y + d2y
         if (w1x - w2x) * nx + (w1y - w2y) * ny > 0.0:
-            return w1x, w1y, w2x, w2y
-    return pair_response(m1, m2, nx, ny, v1x, v1y, v2x, v2y, e, below)
+            n2 = nx * nx + ny * ny
+            along = ((v1x - d1x - v2x + d2x) * nx + (v1y - d1y - v2y + d2y) * ny) / n2
+            return w1x, w1y, w2x, w2y, bounce_factor(along, n2, e, below)
+    w1x, w1y, w2x, w2y = pair_response(m1, m2, nx, ny, v1x, v1y, v2x, v2y, e, below)
+    return w1x, w1y, w2x, w2y, 0.0
 
 
 @inlined
@@ -974,12 +972,12 @@ def _wall_response(outward, pull, lead, forced):
     """Velocity along a wall's outward normal after a bounce, from ``outward`` before it (m/s),
     with the kick-timing correction of pairs when ``forced``: ``pull`` is the acceleration along
     the normal (m/s^2), ``lead`` as in `_pair_response`; ``v' = -(v - delta) + delta`` is kept
-    only if it leaves the wall, else ``-v``."""
+    only if it leaves the wall, else ``-v``. Returns it and whether it was corrected."""
     if forced:
         corrected = -outward + 2.0 * lead * pull
         if corrected < 0.0:
-            return corrected
-    return -outward
+            return corrected, True
+    return -outward, False
 
 
 # --- between the engine and the particles -------------------------------------------------------

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
@@ -340,45 +339,6 @@ class Vessel(ABC):
             position, velocity, radius, mass, dt, self.shape_code, half_width, half_height,
             self.rim, self._segments, self._wall_table, wall_hits, wall_impulse, wall_heat,
         )  # fmt: skip
-
-    def wall_gap(
-        self,
-        contact: int,
-        position: FloatArray,
-        velocity: FloatArray,
-        acceleration: FloatArray,
-        radius: float,
-    ) -> Callable[[float], tuple[float, float]]:
-        """How far a disk of ``radius`` m on the path ``x + v s + a s^2 / 2`` (shapes (2,), m,
-        m/s, m/s^2) is from touching the vessel at ``contact`` (`collidium.kernels.vessels.
-        contacts`) at time s: ``s -> (gap, d gap / ds)``, zero at contact, for Newton's method.
-        For a segment, the squared distance to it less r^2 (m^2); the shape's walls in a unit of
-        the shape's choosing (`_shape_wall_gap`)."""
-        x, v, a = (np.asarray(value, dtype=float) for value in (position, velocity, acceleration))
-        if contact < contacts.SEGMENTS_FROM:
-            return self._shape_wall_gap(contact, x, v, a, radius)
-        row = self._segments[contact - contacts.SEGMENTS_FROM]
-        k = segment_kernels
-        start, tangent = row[[k.X0, k.Y0]], row[[k.TX, k.TY]]
-
-        def gap(s: float) -> tuple[float, float]:
-            at = x + (v + 0.5 * a * s) * s
-            along = min(max(float((at - start) @ tangent), 0.0), float(row[k.LENGTH]))
-            offset = at - (start + along * tangent)
-            return float(offset @ offset) - radius * radius, float(2.0 * offset @ (v + a * s))
-
-        return gap
-
-    def _shape_wall_gap(
-        self,
-        wall: int,
-        position: FloatArray,
-        velocity: FloatArray,
-        acceleration: FloatArray,
-        radius: float,
-    ) -> Callable[[float], tuple[float, float]]:
-        """`wall_gap` for the shape's own wall ``wall``; shapes with walls of their own say."""
-        raise NotImplementedError(f"a {self.kind} has no walls of its own")
 
     def wall_table(self) -> FloatArray:
         """The kernels' table of wall responses, one row per wall (`wall_names` order)."""

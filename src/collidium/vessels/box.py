@@ -6,7 +6,6 @@ The geometry lives here; the fast time-of-impact and reflection arithmetic used 
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any, ClassVar, Literal
 
 import numpy as np
@@ -187,26 +186,6 @@ class Box(Vessel):
                 position, velocity, radius, mass, half_width, half_height, dt, wall_hits,
                 wall_impulse,
             )  # fmt: skip
-
-    def _shape_wall_gap(
-        self,
-        wall: int,
-        position: FloatArray,
-        velocity: FloatArray,
-        acceleration: FloatArray,
-        radius: float,
-    ) -> Callable[[float], tuple[float, float]]:
-        """`Vessel.wall_gap`: the distance (m) along the wall's axis to the contact coordinate,
-        signed towards the wall."""
-        axis = wall // 2
-        half_width, half_height = 0.5 * self.width, 0.5 * self.height
-        target = box_walls.contact_coordinate(wall, radius, half_width, half_height)
-        x, v, a = float(position[axis]), float(velocity[axis]), float(acceleration[axis])
-
-        def gap(s: float) -> tuple[float, float]:
-            return x + (v + 0.5 * a * s) * s - target, v + a * s
-
-        return gap
 
     def _check_pistons(self) -> None:
         """A piston is one of a reflecting box's walls, at most one, in a box without

@@ -8,7 +8,6 @@ by the rim (`collidium.simulation.Simulation.angular_momentum`).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
@@ -102,24 +101,6 @@ class Circle(Vessel):
         """The radius with the round-off allowance, twice (m)."""
         limit = self.radius * (1.0 + tolerance)
         return limit, limit
-
-    def _shape_wall_gap(
-        self,
-        wall: int,
-        position: FloatArray,
-        velocity: FloatArray,
-        acceleration: FloatArray,
-        radius: float,
-    ) -> Callable[[float], tuple[float, float]]:
-        """`Vessel.wall_gap`: ``|x(s)|^2 - (R - r)^2`` (m^2), negative inside."""
-        x, v, a = position, velocity, acceleration  # arrays, from `Vessel.wall_gap`
-        reach = self.radius - radius
-
-        def gap(s: float) -> tuple[float, float]:
-            at = x + (v + 0.5 * a * s) * s
-            return float(at @ at) - reach * reach, float(2.0 * at @ (v + a * s))
-
-        return gap
 
     def describe(self) -> str:
         """``'circle of radius 10 m (centred on 0, 0)'``."""
