@@ -50,7 +50,9 @@ def test_seed_scenes_hold_their_energy_at_the_seed_dt(name, time, bound):
 def test_contacts_under_forces_have_their_kick_timing_corrected_to_second_order(monkeypatch):
     """The charged gas collides about 700 times a second, inside the drifts. With the engine's
     first-order correction alone (O(h^2) each) its collisions cost several times the energy
-    error of the second-order one (`collidium.kernels.kick_timing`)."""
+    error of the second-order one (`collidium.kernels.kick_timing`). Both runs take the Python
+    path, whose correction can be taken out."""
+    monkeypatch.setattr(integrators._SmoothFlight, "of", classmethod(lambda cls, *args: None))
     corrected = max_drift(cd.load("charged-gas"), 2.0)
     monkeypatch.setattr(kick_timing, "correct", lambda *arguments: None)
     first_order = max_drift(cd.load("charged-gas"), 2.0)
@@ -227,10 +229,11 @@ def test_bad_integrator_settings_name_the_field(field, value):
     ],
 )
 def test_compiled_substeps_give_the_python_run_to_round_off(monkeypatch, name, time, atol):
-    """The substeps that meet no contact, flown in compiled calls (whole intervals, or runs of
-    substeps between contacts), give the run of one Python call per substep: the same substep
-    counts and contacts, the motion to round-off (the exact engine advances a disk at each cell
-    crossing; ``atol`` in m and m/s allows for the growth of that round-off in the gas).
+    """The substeps flown in compiled calls (whole intervals, or runs of substeps; their
+    contacts taken by the compiled substeps' own engine) give the run of one Python call per
+    substep: the same substep counts and contacts, the motion to round-off (the exact engine
+    advances a disk at each cell crossing, which the straight flights do not; ``atol`` in m and
+    m/s allows for the growth of that round-off in the gas).
 
     The spectrometer's ions reach the field's edge just at substep ends, where round-off would
     decide whether a half substep turns them (an O(omega h) difference, within the method's
@@ -241,7 +244,7 @@ def test_compiled_substeps_give_the_python_run_to_round_off(monkeypatch, name, t
 
     def counting(*args):
         out = kernel(*args)
-        taken.append(out[0] - args[-6])  # substeps flown: the one reached less the first
+        taken.append(out[0] - args[-7])  # substeps flown: the one reached less the first
         return out
 
     def counting_intervals(*args):
@@ -275,7 +278,7 @@ def _off_the_edge(sim: cd.Simulation) -> cd.Simulation:
 
 def smooth_flight(sim: cd.Simulation) -> object:
     """The compiled substeps' part of a simulation's scene, or None."""
-    return integrators._SmoothFlight.of(sim.particles, sim.container, sim._field)
+    return integrators._SmoothFlight.of(sim.particles, sim.container, sim._field, sim._drift)
 
 
 def test_compiled_substeps_take_a_pair_sum_fields_and_drag_between_fixed_walls():
@@ -310,6 +313,18 @@ def test_compiled_substeps_take_a_pair_sum_fields_and_drag_between_fixed_walls()
         assert smooth_flight(sim) is None
     assert smooth_flight(cd.load("charged-gas", boundary="periodic")) is None
     assert smooth_flight(cd.load("charged-gas", n=PARALLEL_ROWS)) is None  # rows on threads
+
+
+def test_compiled_substeps_take_contacts_with_an_engine_of_their_own():
+    """Under exact collisions, where the drift carries no fall, the compiled substeps take the
+    substeps that meet contacts with the exact engine (`ExactCollisions.substep_engine`); the
+    seed's collision step, a carried gravity and a piston leave them to Python."""
+    assert smooth_flight(cd.load("charged-gas")).takes_contacts
+    assert not smooth_flight(cd.load("charged-gas", collisions="step")).takes_contacts
+    assert not smooth_flight(cd.load("drag")).takes_contacts  # its gravity rides the drift
+    sim = cd.load("charged-gas").run(time=0.5)
+    assert sim.counters.pair_collisions > 100
+    assert sim._integrator.next_in_python is False
 
 
 def test_compiled_substeps_see_charges_edited_in_place():

@@ -22,7 +22,13 @@ import numpy as np
 
 from collidium.errors import SimulationError
 from collidium.kernels import audit, event_flights, events, stepper
-from collidium.kernels.cells import bounding_box, event_grid_shape, grid_window, window_sides
+from collidium.kernels.cells import (
+    WINDOW_FROM,
+    bounding_box,
+    event_grid_shape,
+    grid_window,
+    window_sides,
+)
 from collidium.kernels.floats import largest_magnitude
 from collidium.kernels.substeps import RECORD
 from collidium.kernels.vessels import piston as piston_kernels
@@ -126,13 +132,6 @@ class FlightRecord:
             wanted,
         )
 
-    def tally_of_now(self, steps: int, tally: Tally) -> None:
-        """The first ``steps`` rows of the tallies, those of now: a flight that met no wall and
-        no disk."""
-        self.counts[:steps] = tally.counts
-        self.impulse[:steps] = tally.impulse
-        self.heat[:steps] = tally.heat
-
 
 class ContactLog:
     """The contacts a drift under forces met, for the integrator's correction of their kick
@@ -169,6 +168,54 @@ class ContactLog:
     def contacts(self) -> FloatArray:
         """The rows of the contacts logged."""
         return self.rows[: min(int(self.count[0]), self.rows.shape[0])]
+
+
+@dataclass(frozen=True, eq=False)
+class SubstepEngine:
+    """The exact engine as the compiled substeps take it for the drifts that meet contacts
+    (`ExactCollisions.substep_engine`).
+
+    Attributes
+    ----------
+    queue : tuple of ndarray
+        The engine's arrays in the order `collidium.kernels.events.rebuild` takes them, then the
+        vessel's segments and an empty piston; the queue is built afresh at each drift.
+    walls : ndarray
+        The vessel's wall table (`collidium.kernels.wall_responses`).
+    sort_every : int
+        Events between re-sorts of the slots.
+    reach : float
+        A drift whose largest velocity component times its length exceeds this (m) is refused
+        (left to `ExactCollisions.drift`, which names it).
+    log : ContactLog
+        Where the drifts log their contacts (a drift that overflows it is left to Python).
+    drift : ExactCollisions
+        The mode whose event and queue counters the substeps add to.
+    """
+
+    queue: tuple[np.ndarray, ...]
+    walls: FloatArray
+    sort_every: int
+    reach: float
+    log: ContactLog
+    drift: ExactCollisions
+
+    @classmethod
+    def disabled(cls, vessel: Vessel) -> SubstepEngine:
+        """An engine that takes no drift (``sort_every`` 0) but has the types of a real one, so
+        that the compiled substeps compile once: they leave every substep that meets a contact
+        to Python."""
+        arrays = _engine_arrays(1, 1)
+        geometry, grid = np.zeros(events.GEOMETRY_SIZE), np.zeros(3, dtype=np.int64)
+        queue = (*(arrays[name] for name in ("body",)), geometry, grid,
+                 *(arrays[name] for name in ("head", "next", "event", "keys", "items")),
+                 vessel.segments(), np.empty(0))  # fmt: skip
+        return cls(queue, vessel.wall_table(), 0, 0.0, ContactLog(0), ExactCollisions())
+
+    def took(self, processed: int, drifts: int) -> None:
+        """Count the events the compiled drifts processed and the queues they built."""
+        self.drift.events += processed
+        self.drift.rebuilds += drifts
 
 
 class Drift(Protocol):
@@ -572,27 +619,11 @@ class ExactCollisions:
         piston: FloatArray,
         fall: FloatArray = _NO_FALL,
     ) -> dict[str, np.ndarray]:
-        n = particles.n
-        diameter = 2.0 * float(particles.radius.max(initial=0.0))
-        window = grid_window(particles.position, diameter, vessel.extent, vessel.periodic)
-        width, height = window_sides(window)
-        ncx, ncy = event_grid_shape(width, height, diameter, n)
-        shared = _shared_radius_and_mass(particles)
-        columns = events.BODY_COLUMNS if shared is None else events.SHARED_BODY_COLUMNS
         # Arrays of the same shapes are filled again rather than allocated (with forces the queue
         # is rebuilt at every substep).
         old = self._state if self._state is not None else self._spare
         self._spare = None
-        if old is not None and old["body"].shape == (n, columns) and old["head"].size == ncx * ncy:
-            s = old
-        else:
-            s = _engine_arrays(n, ncx * ncy, columns)
-        half_width, half_height = (0.5 * float(side) for side in vessel.extent)
-        s["geometry"] = np.array(
-            [half_width, half_height, width / ncx, height / ncy, *(shared or (np.nan, np.nan)),
-             vessel.shape_code, vessel.rim, self.restitution, ELASTIC_BELOW, *window[0], *fall]
-        )  # fmt: skip
-        s["grid"] = np.array([ncx, ncy, int(vessel.periodic)], dtype=np.int64)
+        s = self._layout(particles, vessel, fall, old)
         events.load(
             particles.position, particles.velocity, particles.radius, particles.mass,
             s["body"], s["event"],
@@ -604,6 +635,52 @@ class ExactCollisions:
         )
         events.rebuild(now, *(s[name] for name in _QUEUE_ARRAYS), vessel.segments(), s["piston"])
         return s
+
+    def _layout(
+        self,
+        particles: Particles,
+        vessel: Vessel,
+        fall: FloatArray,
+        old: dict[str, np.ndarray] | None = None,
+    ) -> dict[str, np.ndarray]:
+        """The engine's arrays for the particles where they are (``old``'s where they have the
+        shapes needed), with its geometry and grid; the queue not built."""
+        n = particles.n
+        diameter = 2.0 * float(particles.radius.max(initial=0.0))
+        window = grid_window(particles.position, diameter, vessel.extent, vessel.periodic)
+        width, height = window_sides(window)
+        ncx, ncy = event_grid_shape(width, height, diameter, n)
+        shared = _shared_radius_and_mass(particles)
+        columns = events.BODY_COLUMNS if shared is None else events.SHARED_BODY_COLUMNS
+        if old is not None and old["body"].shape == (n, columns) and old["head"].size == ncx * ncy:
+            s = old
+        else:
+            s = _engine_arrays(n, ncx * ncy, columns)
+        half_width, half_height = (0.5 * float(side) for side in vessel.extent)
+        s["geometry"] = np.array(
+            [half_width, half_height, width / ncx, height / ncy, *(shared or (np.nan, np.nan)),
+             vessel.shape_code, vessel.rim, self.restitution, ELASTIC_BELOW, *window[0], *fall]
+        )  # fmt: skip
+        s["grid"] = np.array([ncx, ncy, int(vessel.periodic)], dtype=np.int64)
+        return s
+
+    def substep_engine(self, particles: Particles, vessel: Vessel) -> SubstepEngine | None:
+        """An engine of its own for the compiled substeps' drifts that meet contacts
+        (`collidium.kernels.substeps`), which build its queue afresh at each; None where they
+        cannot take them: a periodic box, a piston, or so many disks that the cells' window
+        follows them (`collidium.kernels.cells.grid_window`)."""
+        if vessel.periodic or vessel.piston is not None or particles.n >= WINDOW_FROM:
+            return None
+        s = self._layout(particles, vessel, _NO_FALL)
+        s["piston"] = np.empty(0)
+        return SubstepEngine(
+            (*(s[name] for name in _QUEUE_ARRAYS), vessel.segments(), s["piston"]),
+            vessel.wall_table(),
+            max(1, self.sort_interval * particles.n),
+            _runaway_reach(vessel),
+            ContactLog(max(64, 4 * particles.n)),
+            self,
+        )
 
     def drift(
         self,

@@ -28,7 +28,14 @@ from typing import Literal
 
 import numpy as np
 
-from collidium.collisions import ContactLog, Drift, FlightRecord, Tally
+from collidium.collisions import (
+    ContactLog,
+    Drift,
+    ExactCollisions,
+    FlightRecord,
+    SubstepEngine,
+    Tally,
+)
 from collidium.errors import SimulationError
 from collidium.forces import ForceField
 from collidium.forces.base import CompiledForces
@@ -115,7 +122,7 @@ class Integrator:
         (`Drift.flies`); with forces that kick, where the integrator does
         (`_flies_with_forces`)."""
         if field.kicks:
-            return self._flies_with_forces(particles, vessel, field)
+            return self._flies_with_forces(particles, vessel, field, drift)
         return (not field.active or field.falls_alone) and drift.flies(particles, tally, field.fall)
 
     def fly(
@@ -148,15 +155,17 @@ class Integrator:
             Output: what the observers read at the end of each step taken.
         """
         if field.kicks:
-            return self._fly_with_forces(particles, vessel, field, origin, elapsed, dt, tally,
-                                         record)  # fmt: skip
+            return self._fly_with_forces(particles, vessel, field, drift, origin, elapsed, dt,
+                                         tally, record)  # fmt: skip
         if field.active and not field.falls_alone:  # the record has no other potential
             return 0
         taken = drift.fly(particles, vessel, origin, elapsed, dt, tally, record, field.fall)
         record.forces[:taken] = tally.forces[0]  # no velocity force gave any
         return taken
 
-    def _flies_with_forces(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
+    def _flies_with_forces(
+        self, particles: Particles, vessel: Vessel, field: ForceField, drift: Drift
+    ) -> bool:
         """Whether `_fly_with_forces` may take steps here (none by default)."""
         return False
 
@@ -165,6 +174,7 @@ class Integrator:
         particles: Particles,
         vessel: Vessel,
         field: ForceField,
+        drift: Drift,
         origin: float,
         elapsed: int,
         dt: float,
@@ -294,11 +304,11 @@ class AdaptiveLeapfrog(Integrator):
         dt: float,
         tally: Tally,
     ) -> None:
-        flight = self._flight_for(particles, vessel, field)
+        flight = self._flight_for(particles, vessel, field, drift)
         tried = flight is not None and not self.next_in_python
         if tried and self._intervals(typing.cast(_SmoothFlight, flight), particles, field, now,
-                                     0, dt, tally, _ONE, _ONE_HEAT):  # fmt: skip
-            return  # the interval met no contact: compiled whole
+                                     0, dt, tally, FlightRecord.empty(tally, _ONE)):  # fmt: skip
+            return  # compiled whole
         start = _Snapshot(particles, tally)
         # The energy the substeps' rate is judged against: the interval's one read of the
         # energies (the forces keep the total within the tolerance over the interval).
@@ -308,7 +318,7 @@ class AdaptiveLeapfrog(Integrator):
         rate2 = (
             _squared_rate(particles, vessel, field, total)
             if flight is None
-            else flight.squared_rate(particles, field, total)
+            else flight.squared_rate(particles, field, tally, total)
         )
         if not dt * math.sqrt(rate2) <= MAX_SUBSTEPS * self.tolerance:  # also NaN
             raise SimulationError(
@@ -334,55 +344,55 @@ class AdaptiveLeapfrog(Integrator):
         self.substeps = max(1, n // 2) if required <= n // 2 else n
 
     def _flight_for(
-        self, particles: Particles, vessel: Vessel, field: ForceField
+        self, particles: Particles, vessel: Vessel, field: ForceField, drift: Drift
     ) -> _SmoothFlight | None:
         """The scene's part in the compiled substeps (`_SmoothFlight`), kept while it fits."""
-        if self._flight is None or not self._flight.fits(particles, vessel, field):
-            self._flight = _SmoothFlight.of(particles, vessel, field)
+        if self._flight is None or not self._flight.fits(particles, vessel, field, drift):
+            self._flight = _SmoothFlight.of(particles, vessel, field, drift)
         return self._flight
 
-    def _flies_with_forces(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
+    def _flies_with_forces(
+        self, particles: Particles, vessel: Vessel, field: ForceField, drift: Drift
+    ) -> bool:
         """Whether `_fly_with_forces` may take steps here: forces that the compiled substeps
         take, in a small scene (`_SmoothFlight.of`), and a next interval not left to Python."""
-        return not self.next_in_python and self._flight_for(particles, vessel, field) is not None
+        flight = self._flight_for(particles, vessel, field, drift)
+        return not self.next_in_python and flight is not None
 
     def _fly_with_forces(
         self,
         particles: Particles,
         vessel: Vessel,
         field: ForceField,
+        drift: Drift,
         origin: float,
         elapsed: int,
         dt: float,
         tally: Tally,
         record: FlightRecord,
     ) -> int:
-        """Whole intervals that meet no contact, compiled
-        (`collidium.kernels.substeps.smooth_intervals`): `step` takes each such interval by the
-        same call, so both give the same bits. They touch no wall and no disk: the tallies are
-        those of now, but for the energy the drag gave."""
-        if not self._flies_with_forces(particles, vessel, field):
+        """Whole intervals, compiled (`collidium.kernels.substeps.smooth_intervals`), their
+        contacts taken by the exact engine where the scene has one (`_SmoothFlight.engine`):
+        `step` takes each such interval by the same call, so both give the same bits."""
+        if not self._flies_with_forces(particles, vessel, field, drift):
             return 0
         flight = typing.cast(_SmoothFlight, self._flight)
-        flown = self._intervals(flight, particles, field, origin, elapsed, dt, tally,
-                                record.values, record.forces)  # fmt: skip
-        record.tally_of_now(flown, tally)
-        # The interval left meets a contact (or too many substeps, or a value not finite):
-        # `step` takes it next, and need not try it again.
+        flown = self._intervals(flight, particles, field, origin, elapsed, dt, tally, record)
+        # The interval left meets a contact the compiled substeps leave to Python (or too many
+        # substeps, or a value not finite): `step` takes it next, and need not try it again.
         self.next_in_python = flown < record.values.shape[0]
         return flown
 
     def _intervals(self, flight: _SmoothFlight, particles: Particles, field: ForceField,
-                   origin: float, elapsed: int, dt: float, tally: Tally, record: FloatArray,
-                   heat: FloatArray) -> int:  # fmt: skip
+                   origin: float, elapsed: int, dt: float, tally: Tally,
+                   record: FlightRecord) -> int:  # fmt: skip
         """`_SmoothFlight.intervals` from the substep count kept, which it updates, and the
         energy the drag gave, which it adds to the ``tally``."""
         flown, self.substeps = flight.intervals(
-            particles, field, origin, elapsed, dt, self.substeps, self.tolerance,
-            float(tally.forces[0]), record, heat,
-        )  # fmt: skip
+            particles, field, origin, elapsed, dt, self.substeps, self.tolerance, tally, record
+        )
         if flown:
-            tally.forces[0] = heat[flown - 1]
+            tally.forces[0] = record.forces[flown - 1]
         return flown
 
     def _interval(
@@ -412,8 +422,8 @@ class AdaptiveLeapfrog(Integrator):
         while s <= n:
             if flight is not None:  # as many substeps as meet no contact, compiled
                 now_total = total + (_given(tally) - given)
-                s, t, fastest, drag = flight.substeps(particles, field, now, dt, s, n, t, fastest,
-                                                      now_total)  # fmt: skip
+                s, t, fastest, drag = flight.substeps(particles, field, tally, now, dt, s, n, t,
+                                                      fastest, now_total)  # fmt: skip
                 tally.forces[0] += drag
                 if s > n:
                     break
@@ -423,7 +433,8 @@ class AdaptiveLeapfrog(Integrator):
             now_total = total + (_given(tally) - given)
             fastest = max(fastest, _squared_rate(particles, vessel, field, now_total))
             s += 1
-        return fastest, met
+        # Where the compiled substeps take contacts, Python takes only what they leave.
+        return fastest, met and (flight is None or not flight.takes_contacts)
 
     def _substep(
         self,
@@ -442,6 +453,7 @@ class AdaptiveLeapfrog(Integrator):
         h = end - t
         before = _Snapshot(particles, tally)
         acceleration = field.acceleration.copy()
+        hits = int(tally.counts.sum())
         log = self._log
         while True:
             log.clear()
@@ -456,7 +468,7 @@ class AdaptiveLeapfrog(Integrator):
             _corrected(log, particles, vessel, field, t, h, before.position, acceleration, after)
 
         _closing_kick(particles, vessel, field, h, tally, last, corrected if log.count[0] else None)
-        return bool(log.count[0])
+        return int(tally.counts.sum()) > hits
 
 
 def _corrected(
@@ -476,8 +488,9 @@ def _corrected(
     before the closing kick."""
     width, height = (float(side) for side in vessel.size)
     kick_timing.correct(
-        log.contacts, t, h, start, particles.position, before, after, particles.velocity,
-        writable(particles.mass), *field.pair_laws(particles), width, height, vessel.periodic,
+        log.rows, int(log.count[0]), t, h, start, particles.position, before, after,
+        particles.velocity, writable(particles.mass), *field.pair_laws(particles), width, height,
+        vessel.periodic,
     )  # fmt: skip
 
 
@@ -541,9 +554,12 @@ class _SmoothFlight:
     vessel and forces it was made for, copies of the masses, radii and charges, the forces as
     the substeps take them (`ForceField.compiled`: the pair force's sources, coupling and
     squared softening, a uniform field's forces and carried fall, a magnetic field's frequencies
-    and region, a drag's rates), and the walls as the exact engine has them. The integrator
-    keeps it while it `fits`: making it is most of the Python work of a small scene's reporting
-    interval."""
+    and region, a drag's rates), the walls as the exact engine has them, and under exact
+    collisions an engine of its own for the substeps that meet contacts
+    (`collidium.collisions.ExactCollisions.substep_engine`; a disabled one where Python takes
+    them). The
+    integrator keeps it while it `fits`: making it is most of the Python work of a small scene's
+    reporting interval."""
 
     vessel: Vessel
     field: ForceField
@@ -553,14 +569,19 @@ class _SmoothFlight:
     charge: FloatArray
     source: FloatArray
     walls: tuple[int, float, float, float, FloatArray]
+    drift: Drift
+    engine: SubstepEngine
 
     @classmethod
-    def of(cls, particles: Particles, vessel: Vessel, field: ForceField) -> _SmoothFlight | None:
+    def of(
+        cls, particles: Particles, vessel: Vessel, field: ForceField, drift: Drift
+    ) -> _SmoothFlight | None:
         """The scene's part, or None unless the vessel has walls (not periodic), the particles
         are few enough for one thread (`PARALLEL_DIRECT_FROM`) and the forces are those the
         substeps take (`ForceField.compiled`; a vessel with a piston has no pair sum of
         theirs). A substep that meets no contact is a straight flight in every collision
-        mode."""
+        mode; one that meets contacts takes the exact engine, where there is one and the drift
+        carries no fall."""
         if vessel.periodic or particles.n >= PARALLEL_DIRECT_FROM:
             return None
         forces = field.compiled(particles, vessel)
@@ -570,18 +591,25 @@ class _SmoothFlight:
         walls = (vessel.shape_code, half_width, half_height, vessel.rim, vessel.segments())
         name = forces.source
         source = np.zeros(particles.n) if name is None else getattr(particles, name)
+        engine = (
+            drift.substep_engine(particles, vessel)
+            if isinstance(drift, ExactCollisions) and forces.fall.size == 0
+            else None
+        ) or SubstepEngine.disabled(vessel)
         # Contiguous copies: the particles' arrays may be edited in place (`fits` compares), and
         # a shared value is a stride-0 view, which would compile the substeps again.
         return cls(vessel, field, forces, np.array(particles.mass), np.array(particles.radius),
-                   np.array(particles.charge), np.array(source), walls)  # fmt: skip
+                   np.array(particles.charge), np.array(source), walls, drift,
+                   engine)  # fmt: skip
 
-    def fits(self, particles: Particles, vessel: Vessel, field: ForceField) -> bool:
-        """Whether this is still the scene's part: the same vessel and forces, and particles of
-        the same masses, radii and charges (the uniform field, the magnetic field and the pair
-        force's sources are of those)."""
+    def fits(self, particles: Particles, vessel: Vessel, field: ForceField, drift: Drift) -> bool:
+        """Whether this is still the scene's part: the same vessel, forces and drift, and
+        particles of the same masses, radii and charges (the uniform field, the magnetic field
+        and the pair force's sources are of those)."""
         return (
             vessel is self.vessel
             and field is self.field
+            and drift is self.drift
             and np.array_equal(particles.mass, self.mass)
             and np.array_equal(particles.radius, self.radius)
             and np.array_equal(particles.charge, self.charge)
@@ -603,31 +631,55 @@ class _SmoothFlight:
         dt: float,
         starting: int,
         tolerance: float,
-        given: float,
-        record: FloatArray,
-        heat: FloatArray,
+        tally: Tally,
+        record: FlightRecord,
     ) -> tuple[int, int]:
-        """Whole intervals, up to ``len(record)``, that meet no contact, the first taken with
-        ``starting`` substeps or more (`collidium.kernels.substeps.smooth_intervals`):
-        ``(intervals taken, the substep count the next starts from)``; ``heat`` gets the energy
-        the velocity forces have given at each one's end, from ``given`` J before the first.
-        The field's acceleration is kept current."""
-        flown, after = substeps.smooth_intervals(
+        """Whole intervals, up to ``len(record.values)``, the first taken with ``starting``
+        substeps or more (`collidium.kernels.substeps.smooth_intervals`), up to one that meets
+        a contact left to Python: ``(intervals taken, the substep count the next starts
+        from)``. The ``record`` gets the energies and the tallies at each one's end, its
+        ``forces`` the energy the velocity forces have given, from the ``tally``'s. The field's
+        acceleration is kept current."""
+        flown, after, processed, drifts = substeps.smooth_intervals(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
-            *self._forces, *self.walls, origin, elapsed, dt, record.shape[0], starting,
-            tolerance, MAX_SUBSTEPS, TOTAL_ENERGY_FLOOR, given, record, heat,
+            *self._forces, *self.walls, origin, elapsed, dt, record.values.shape[0], starting,
+            tolerance, MAX_SUBSTEPS, TOTAL_ENERGY_FLOOR, float(tally.forces[0]), record.values,
+            record.forces, self._contacts(particles, tally), record.counts, record.impulse,
+            record.heat,
         )  # fmt: skip
+        self._took(processed, drifts)
         return int(flown), int(after)
 
-    def squared_rate(self, particles: Particles, field: ForceField, total: float) -> float:
+    @property
+    def takes_contacts(self) -> bool:
+        """Whether the compiled substeps take the substeps that meet contacts."""
+        return self.engine.sort_every > 0
+
+    def _contacts(self, particles: Particles, tally: Tally) -> tuple[object, ...]:
+        """The engine's arguments of the compiled substeps (`smooth_substeps`'s
+        ``contacts``), with the ``tally``'s arrays."""
+        engine = self.engine
+        return (engine.queue, engine.walls, engine.sort_every, engine.reach, engine.log.rows,
+                engine.log.count, particles.image, tally.counts, tally.impulse,
+                tally.heat)  # fmt: skip
+
+    def _took(self, processed: int, drifts: int) -> None:
+        """Count the engine's events and queue builds in the compiled substeps."""
+        if self.takes_contacts:
+            self.engine.took(int(processed), int(drifts))
+
+    def squared_rate(
+        self, particles: Particles, field: ForceField, tally: Tally, total: float
+    ) -> float:
         """`_squared_rate` of the current state, compiled (the same to round-off)."""
-        _, _, rate2, _ = self.substeps(particles, field, 0.0, 0.0, 1, 0, 0.0, -1.0, total)
+        _, _, rate2, _ = self.substeps(particles, field, tally, 0.0, 0.0, 1, 0, 0.0, -1.0, total)
         return rate2
 
     def substeps(
         self,
         particles: Particles,
         field: ForceField,
+        tally: Tally,
         now: float,
         dt: float,
         first: int,
@@ -636,22 +688,22 @@ class _SmoothFlight:
         fastest: float,
         total: float,
     ) -> tuple[int, float, float, float]:
-        """Regular substeps from ``first`` of ``count`` up to the first that may meet a
-        contact (`collidium.kernels.substeps.smooth_substeps`, given the ``total`` energy J):
-        ``(that substep, its start in s, the largest squared rate, the energy the drag gave in
-        J)``. The field's acceleration is kept current; its energies are summed again when
-        read."""
-        return substeps.smooth_substeps(
+        """Regular substeps from ``first`` of ``count`` up to the first left to Python
+        (`collidium.kernels.substeps.smooth_substeps`, given the ``total`` energy J; their
+        contacts added to the ``tally``): ``(that substep, its start in s, the largest squared
+        rate, the energy the drag gave in J)``. The field's acceleration is kept current; its
+        energies are summed again when read."""
+        s, reached, rate2, drag, processed, drifts = substeps.smooth_substeps(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
             *self._forces, *self.walls, now, dt, first, count, t,
-            fastest, total, TOTAL_ENERGY_FLOOR,
+            fastest, total, TOTAL_ENERGY_FLOOR, self._contacts(particles, tally),
         )  # fmt: skip
+        self._took(processed, drifts)
+        return int(s), float(reached), float(rate2), float(drag)
 
 
-#: The record of a single compiled interval, not read, and the energy given by its end
-#: (`AdaptiveLeapfrog._with_forces`).
-_ONE = np.empty((1, len(substeps.RECORD)))
-_ONE_HEAT = np.empty(1)
+#: Which rows of a single compiled interval's record are read (`AdaptiveLeapfrog._with_forces`).
+_ONE = np.ones(1, dtype=bool)
 
 
 class _Snapshot:

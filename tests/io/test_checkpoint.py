@@ -181,14 +181,15 @@ def test_arrays_of_objects_are_refused_not_pickled_and_nothing_is_left(tmp_path)
 
 
 def test_a_run_saved_just_after_a_contact_under_forces_resumes_bitwise(tmp_path):
-    """charged-opposite saved at the end of its first interval with a collision: the adaptive
+    """charged-opposite under the seed's collision step, whose contacts the compiled substeps
+    leave to Python, saved at the end of its first interval with a collision: the adaptive
     integrator takes the next interval in Python rather than trying it whole, and so does the
     resumed run, which ends bit for bit as the uninterrupted one."""
-    first = cd.load("charged-opposite")
+    first = cd.load("charged-opposite", collisions="step")
     while not first._integrator.next_in_python:
         first.run(steps=1)
     first.save(tmp_path / "run.ckpt")
-    whole = cd.load("charged-opposite").run(steps=first.steps + 100)
+    whole = cd.load("charged-opposite", collisions="step").run(steps=first.steps + 100)
     resumed = cd.restore(tmp_path / "run.ckpt")
     assert resumed._integrator.next_in_python
     assert_same_run(whole, resumed.run(steps=100))

@@ -22,8 +22,9 @@ def corrected(contacts, t0, h, start, position, before, after, velocity, mass, l
     couplings = np.array([law[1] for law in laws], dtype=float)
     softenings2 = np.array([law[2] for law in laws], dtype=float)
     width, height = (10.0, 10.0) if size is None else size
-    kick_timing.correct(contacts, t0, h, start, position, before, after, out, mass, sources,
-                        couplings, softenings2, width, height, size is not None)  # fmt: skip
+    kick_timing.correct(contacts, contacts.shape[0], t0, h, start, position, before, after, out,
+                        mass, sources, couplings, softenings2, width, height,
+                        size is not None)  # fmt: skip
     return out
 
 

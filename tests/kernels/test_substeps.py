@@ -1,4 +1,6 @@
-"""The compiled contact-free substeps against their NumPy twin, and where they stop."""
+"""The compiled substeps that meet no contact against their NumPy twin, and where they stop
+when no engine takes their contacts (those that do are run against the Python path in
+``tests/test_integrators.py``)."""
 
 from __future__ import annotations
 
@@ -7,17 +9,33 @@ import math
 import numpy as np
 import pytest
 
-from collidium import Polygon
-from collidium.kernels import reference
-from collidium.kernels.substeps import (
-    CONTACT_MARGIN,
-    RECORD,
-    needed,
-    smooth_intervals,
-    smooth_substeps,
-)
+from collidium import Box, Polygon
+from collidium.collisions import SubstepEngine
+from collidium.kernels import reference, substeps
+from collidium.kernels.substeps import CONTACT_MARGIN, RECORD, needed
 from collidium.kernels.sums import kinetic_energy
 from collidium.kernels.vessels import BOX, CIRCLE, POLYGON
+
+
+def no_engine() -> tuple[object, ...]:
+    """``contacts`` without an engine (`SubstepEngine.disabled`), and a box's tallies."""
+    engine = SubstepEngine.disabled(Box(10, 10))
+    tally = (np.zeros(5, dtype=np.int64), np.zeros(5), np.zeros(5))
+    return (engine.queue, engine.walls, engine.sort_every, engine.reach, engine.log.rows,
+            engine.log.count, np.zeros((1, 2), dtype=np.int64), *tally)  # fmt: skip
+
+
+def smooth_substeps(*arguments):
+    """`substeps.smooth_substeps` without an engine: ``(substep, time, fastest, given)``."""
+    return substeps.smooth_substeps(*arguments, no_engine())[:4]
+
+
+def smooth_intervals(*arguments):
+    """`substeps.smooth_intervals` without an engine: ``(intervals, next count)``."""
+    count = arguments[21]
+    tallies = (np.empty((count, 5), dtype=np.int64), np.empty((count, 5)), np.empty((count, 5)))
+    return substeps.smooth_intervals(*arguments, no_engine(), *tallies)[:2]
+
 
 FLOOR = 10.0
 NONE = np.empty((0, 9))

@@ -30,6 +30,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from collidium.kernels.compilation import uncounted
 from collidium.kernels.events import (
     LOG_BOUNCE,
     LOG_NX,
@@ -41,9 +42,10 @@ from collidium.kernels.events import (
 from collidium.kernels.pairwise import inverse_distance_pair
 
 
-@numba.njit(cache=True, error_model="numpy")
+@uncounted(error_model="numpy")
 def correct(
     contacts: np.ndarray,
+    count: int,
     start_time: float,
     h: float,
     start: np.ndarray,
@@ -65,8 +67,9 @@ def correct(
     Parameters
     ----------
     contacts : ndarray, shape (K, `collidium.kernels.events.LOG_COLUMNS`)
-        The substep's contacts in the order they happened, as the engine logs them; those with
-        a bounce factor of 0 (not corrected to first order) are left out.
+        The substep's contacts in the order they happened, as the engine logs them, in the
+        first ``count`` rows; those with a bounce factor of 0 (not corrected to first order)
+        are left out.
     start_time, h : float
         The substep's start and length, s.
     start, position : ndarray, shape (N, 2)
@@ -84,7 +87,7 @@ def correct(
     width, height, periodic
         The box's sides (m) and whether separations take the minimum image.
     """
-    for c in range(contacts.shape[0]):
+    for c in range(count):
         bounce = contacts[c, LOG_BOUNCE]
         if bounce == 0.0:
             continue

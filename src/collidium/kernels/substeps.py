@@ -26,7 +26,9 @@ import math
 import numba
 import numpy as np
 
+from collidium.kernels import events, kick_timing
 from collidium.kernels.compilation import uncounted
+from collidium.kernels.floats import largest_magnitude
 from collidium.kernels.pairwise import MOST_BLOCKS, larger, pair_sums, stiffness_row
 from collidium.kernels.sorting import sort_nearly_sorted
 from collidium.kernels.sums import kinetic_energy, momentum, total_speed
@@ -55,10 +57,11 @@ def energy_scale(kinetic: float, total: float, floor: float) -> float:
 def smooth_substeps(
     position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, fall,
     turn, region, damp, shape, half_width, half_height, rim, segments, now, dt, first, count, t,
-    fastest, total, energy_floor,
-) -> tuple[int, float, float, float]:  # fmt: skip
+    fastest, total, energy_floor, contacts,
+) -> tuple[int, float, float, float, int, int]:  # fmt: skip
     """Regular substeps ``first, first + 1, ...`` of ``count`` in the interval from ``now`` of
-    ``dt`` (s), in place, up to the first that may meet a contact.
+    ``dt`` (s), in place, up to the first that may meet a contact and that the exact engine
+    cannot take here (`_contact_drift`), or whose values stop being finite.
 
     Substep s ends at ``now + dt s / count``; it is the velocity forces' flow for ``h / 2``
     (`_flowed`: the drag, the magnetic field's turn), a kick ``v += a h / 2``, the straight flight
@@ -107,32 +110,40 @@ def smooth_substeps(
     energy_floor : float
         The rate's energy scale is ``|KE + U|`` but at least ``(KE + |U|) / energy_floor``
         (`energy_scale`).
+    contacts : tuple
+        The exact engine for the substeps that meet contacts (`_contact_drift`): its queue's
+        arrays, the wall table, the events between re-sorts, the runaway reach (m), the contact
+        log's rows and count, the particles' periodic images and the tally's counts, impulses
+        and heat, which its contacts add to. With 0 events between re-sorts there is no
+        engine: a substep that may meet a contact is left to the integrator.
 
     Returns
     -------
     tuple
-        ``(substep, time, fastest, given)``: the substep not taken (``count + 1`` when all
-        were), its start (s), the largest squared rate and the energy the drag gave in the
-        substeps taken (J, negative).
+        ``(substep, time, fastest, given, events, drifts)``: the substep not taken
+        (``count + 1`` when all were), its start (s), the largest squared rate, the energy the
+        drag gave in the substeps taken (J, negative), and the events the engine processed in
+        the drifts it took.
     """
-    work = _work(mass, source)
+    work = _work(mass, source, coupling, softening2, contacts[-3:])
     walls = (shape, half_width, half_height, rim, segments)
     external = (uniform, fall, turn, region, damp)
     return _substeps(position, velocity, acceleration, mass, radius, coupling, softening2,
                      external, walls, now, dt, first, count, t, fastest, total, energy_floor,
-                     work)  # fmt: skip
+                     work, contacts)  # fmt: skip
 
 
 @numba.njit(cache=True, error_model="numpy")
 def smooth_intervals(
     position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, fall,
     turn, region, damp, shape, half_width, half_height, rim, segments, origin, elapsed, dt,
-    count, substeps, tolerance, most_substeps, energy_floor, given, record, heat,
-) -> tuple[int, int]:  # fmt: skip
+    count, substeps, tolerance, most_substeps, energy_floor, given, record, heat, contacts,
+    counts, impulses, heats,
+) -> tuple[int, int, int, int]:  # fmt: skip
     """Up to ``count`` whole reporting intervals of ``dt`` (s), in place, each as the adaptive
     integrator takes one (`collidium.integrators.AdaptiveLeapfrog`), up to the first that meets
-    a contact or a value that is not finite, or needs more than ``most_substeps``: that one is
-    left as it began, for the integrator.
+    a contact the engine cannot take here or a value that is not finite, or needs more than
+    ``most_substeps``: that one is left as it began, for the integrator.
 
     Interval k starts at ``origin + (elapsed + k) dt``, the simulation's clock. Its substep count
     is the larger of ``substeps`` and the fewest the rate at its start needs (`needed`); it is
@@ -170,14 +181,22 @@ def smooth_intervals(
     heat : ndarray, shape (count,)
         Output: ``given`` at each interval's end, each interval's drag added as the integrator
         adds it to the tally.
+    contacts : tuple
+        As in `smooth_substeps`.
+    counts, impulses, heats : ndarray, shape (count, 1 + W)
+        Output: the tally's counts, impulses and heat at each interval's end.
 
     Returns
     -------
     tuple of int
-        ``(intervals taken, the substep count the next interval starts from)``.
+        ``(intervals taken, the substep count the next interval starts from, events, drifts)``:
+        the events the engine processed in the drifts it took.
     """
     n = position.shape[0]
-    work = _work(mass, source)
+    work = _work(mass, source, coupling, softening2, contacts[-3:])
+    tally = contacts[-3:]
+    kept = (tally[0].copy(), tally[1].copy(), tally[2].copy())
+    processed = drifts = 0
     walls = (shape, half_width, half_height, rim, segments)
     external = (uniform, fall, turn, region, damp)
     flows2 = _flows2(turn, damp)
@@ -190,21 +209,26 @@ def smooth_intervals(
         rate2 = _squared_rate(position, velocity, mass, coupling, softening2, flows2, total,
                               energy_floor, sources)  # fmt: skip
         if not dt * math.sqrt(rate2) <= most_substeps * tolerance:  # also NaN
-            return k, substeps
+            return k, substeps, processed, drifts
         taken = max(substeps, needed(rate2, dt, tolerance, most_substeps))
         _keep(position, velocity, acceleration, start)
+        _keep_tally(tally, kept)
         while True:
-            s, _, fastest, drag = _substeps(position, velocity, acceleration, mass, radius,
-                                            coupling, softening2, external, walls, now, dt, 1,
-                                            taken, now, rate2, total, energy_floor,
-                                            work)  # fmt: skip
-            if s <= taken:  # a contact, or a value not finite
+            s, _, fastest, drag, done, drifted = _substeps(
+                position, velocity, acceleration, mass, radius, coupling, softening2, external,
+                walls, now, dt, 1, taken, now, rate2, total, energy_floor, work, contacts,
+            )  # fmt: skip
+            if s <= taken:  # a contact left to Python, or a value not finite
                 _restore(position, velocity, acceleration, start)
-                return k, substeps
+                _keep_tally(kept, tally)
+                return k, substeps, processed, drifts
+            processed += done
+            drifts += drifted
             required = needed(fastest, dt, tolerance, most_substeps)
             if required <= taken:
                 break
             _restore(position, velocity, acceleration, start)
+            _keep_tally(kept, tally)
             taken = max(required, 2 * taken)
         substeps = max(1, taken // 2) if required <= taken // 2 else taken
         given += drag
@@ -217,7 +241,8 @@ def smooth_intervals(
         record[k, 3] = px
         record[k, 4] = py
         record[k, 5] = total_speed(velocity)
-    return count, substeps
+        _keep_tally(tally, (counts[k], impulses[k], heats[k]))
+    return count, substeps, processed, drifts
 
 
 @numba.njit(cache=True)
@@ -234,11 +259,13 @@ def needed(rate2: float, dt: float, tolerance: float, most: int) -> int:
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _work(mass, source):
+def _work(mass, source, coupling, softening2, tally):
     """What `_substeps` works in, for N particles of which m have a source: kicked, flown and
     pulled motions (N, 2); the indices, sources and inverse masses of those m; rows for their
     coordinates and velocities (m,) each, their pair sums (4, m) and the sums' buffer; the
-    sweep's order and interval ends (N,) (`_meets_contact`)."""
+    sweep's order and interval ends (N,) (`_meets_contact`); the pair force's law as
+    `collidium.kernels.kick_timing.correct` takes it (sources (1, N), coupling and squared
+    softening (1,)); a copy of the ``tally``'s counts, impulses and heat, to put back."""
     n = mass.shape[0]
     m = 0
     for i in range(n):
@@ -255,13 +282,16 @@ def _work(mass, source):
     rows = (np.empty(m), np.empty(m), np.empty(m), np.empty(m))
     sums = (np.empty((4, m)), np.empty(4 * m * (MOST_BLOCKS // 2)))
     sweep = (np.arange(n), np.empty(n), np.empty(n))
+    law = (source.copy().reshape((1, n)), np.full(1, coupling), np.full(1, softening2))
+    kept = (tally[0].copy(), tally[1].copy(), tally[2].copy())
     # Concatenated: numba builds an unpacked (*a, *b) through a list, which holds one type.
-    return motion + (index, charged, inverse_mass) + rows + sums + sweep  # noqa: RUF005
+    return motion + (index, charged, inverse_mass) + rows + sums + sweep + law + kept  # noqa: RUF005
 
 
 @uncounted(error_model="numpy")
 def _substeps(position, velocity, acceleration, mass, radius, coupling, softening2, external,
-              walls, now, dt, first, count, t, fastest, total, energy_floor, work):  # fmt: skip
+              walls, now, dt, first, count, t, fastest, total, energy_floor, work,
+              contacts):  # fmt: skip
     """`smooth_substeps` in its work arrays (`_work`), the uniform field and the velocity
     forces as one tuple (``uniform, fall, turn, region, damp``), the vessel as another.
 
@@ -270,10 +300,16 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     0.6 us."""
     kicked, flown, pull = work[:3]
     index, charged, inverse_mass, x, y, vx, vy, sums, buffer = work[3:12]
-    order, low, high = work[12:]
+    order, low, high = work[12:15]
+    law = work[15:18]
     uniform, fall, turn, region, damp = external
+    log, logged = contacts[4:6]
+    tally = contacts[-3:]
+    kept = work[18:]
+    engine = contacts[2] > 0  # events between re-sorts: 0 for no engine
     n = position.shape[0]
     given = 0.0
+    processed = drifts = 0
     flows2 = _flows2(turn, damp)
     if fastest < 0.0:
         fastest = _squared_rate(position, velocity, mass, coupling, softening2, flows2, total,
@@ -288,16 +324,34 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
             kicked[i, 0] = _kicked(wx, acceleration[i, 0], fall, 0, 0.5 * h)
             kicked[i, 1] = _kicked(wy, acceleration[i, 1], fall, 1, 0.5 * h)
             before += heat
-        if not _finite(kicked) or _meets_contact(position, kicked, radius, h, walls, order, low,
-                                                 high):  # fmt: skip
-            return s, t, fastest, given
-        for i in range(n):
-            for d in range(2):
-                flown[i, d] = position[i, d] + kicked[i, d] * h
+        if not _finite(kicked):
+            return s, t, fastest, given, processed, drifts
+        meets = _meets_contact(position, kicked, radius, h, walls, order, low, high)
+        if meets:  # the exact engine takes the drift, if it may
+            if not engine:
+                return s, t, fastest, given, processed, drifts
+            _keep_tally(tally, kept)
+            done = _contact_drift(position, kicked, radius, mass, acceleration, t, h, contacts,
+                                  flown)  # fmt: skip
+            if done < 0:
+                _keep_tally(kept, tally)
+                return s, t, fastest, given, processed, drifts
+        else:
+            done = 0
+            for i in range(n):
+                for d in range(2):
+                    flown[i, d] = position[i, d] + kicked[i, d] * h
         _accelerations(flown, mass, coupling, softening2, uniform, fall, index, charged, x, y,
                        sums, buffer, pull)  # fmt: skip
         if not _finite(pull):
-            return s, t, fastest, given
+            if meets:
+                _keep_tally(kept, tally)
+            return s, t, fastest, given, processed, drifts
+        if meets:
+            kick_timing.correct(log, logged[0], t, h, position, flown, acceleration, pull,
+                                kicked, mass, law[0], law[1], law[2], 0.0, 0.0, False)  # fmt: skip
+            processed += done
+            drifts += 1
         after = 0.0
         for i in range(n):  # the kick, then the flow for h / 2
             for d in range(2):
@@ -314,7 +368,43 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
                       energy_floor, index, charged, inverse_mass, x, y, vx, vy)  # fmt: skip
         if rate2 > fastest:
             fastest = rate2
-    return count + 1, t, fastest, given
+    return count + 1, t, fastest, given, processed, drifts
+
+
+@uncounted(error_model="numpy")
+def _contact_drift(position, kicked, radius, mass, acceleration, t, h, contacts, flown) -> int:
+    """The drift of a substep that meets contacts, by the exact engine, as
+    `collidium.collisions.ExactCollisions.drift` takes it: the queue built afresh from the
+    positions at ``t`` (s) and the ``kicked`` velocities, run to ``t + h`` with the kick timing
+    of ``acceleration`` and the contacts logged, the positions and velocities at the end written
+    to ``flown`` and ``kicked``. Returns the events processed, or -1 where the integrator must
+    take the substep (a runaway speed, time stuck, more contacts than the log holds); the
+    tallies are then part-way, for the caller to put back."""
+    queue, walls, sort_every, reach, log, logged, image, counts, impulse, heat = contacts
+    body, geometry, grid, head, next_, event, keys, items, segments, piston = queue
+    if not largest_magnitude(kicked) * h <= reach:  # also NaN
+        return -1
+    events.load(position, kicked, radius, mass, body, event)
+    events.rebuild(t, body, geometry, grid, head, next_, event, keys, items, segments, piston)
+    logged[0] = 0
+    done = events.run_events(t + h, body, image, geometry, grid, head, next_, event, keys, items,
+                             counts, impulse, acceleration, t + 0.5 * h, sort_every, log,
+                             logged, walls, heat, segments, piston)  # fmt: skip
+    if done < 0 or logged[0] > log.shape[0]:
+        return -1
+    events.synchronise(t + h, body, event, geometry, grid, flown, kicked)
+    return done
+
+
+@uncounted()
+def _keep_tally(source, target) -> None:
+    """Copy the tally's counts, impulses and heat ``source`` into ``target``."""
+    counts, impulse, heat = source
+    to_counts, to_impulse, to_heat = target
+    for w in range(counts.shape[0]):
+        to_counts[w] = counts[w]
+        to_impulse[w] = impulse[w]
+        to_heat[w] = heat[w]
 
 
 @numba.njit(cache=True, inline="always")
