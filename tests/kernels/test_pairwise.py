@@ -178,6 +178,48 @@ def test_stiffness_equals_numpy_twin(rng, n, periodic):
     assert got == pytest.approx(want, rel=1e-12)
 
 
+def full_rows(x, y, vx, vy, q, inverse_mass, coupling, softening2):
+    """Every row of the stiffness in full (`pairwise.stiffness_row`), the largest."""
+    largest = 0.0
+    for c in range(x.size):
+        row = pairwise.stiffness_row(c, x, y, vx, vy, q, inverse_mass, coupling, softening2, 0.0,
+                                     0.0, False, x.size)  # fmt: skip
+        largest = pairwise.larger(largest, row)
+    return largest
+
+
+@pytest.mark.parametrize("softening2", [0.0, 0.01, 4.0])
+def test_pruned_stiffness_is_every_row_bit_for_bit(rng, softening2):
+    """Gases of 32 to 300 particles, charges and masses of several sizes, one pair touching:
+    leaving out the pairs too far apart along x to matter gives the same bits, from any order."""
+    for n in (32, 57, 200, 300):
+        x, y = rng.uniform(-10.0, 10.0, (2, n))
+        x[1], y[1] = x[0] + 0.5, y[0]  # one pair close
+        vx, vy = rng.normal(0.0, 7.0, (2, n))
+        q = rng.choice([-1.0, 1.0, 2.5], n)
+        inverse_mass = 1.0 / rng.uniform(0.5, 3.0, n)
+        want = full_rows(x, y, vx, vy, q, inverse_mass, 5.0, softening2)
+        for order in (np.arange(n), rng.permutation(n)):
+            got = pairwise.pruned_stiffness(x, y, vx, vy, q, inverse_mass, 5.0, softening2, order,
+                                            np.empty((6, n)))  # fmt: skip
+            assert got == want and np.all(np.diff(x[order]) >= 0.0)  # left sorted
+
+
+@pytest.mark.parametrize("bad", [math.inf, math.nan])
+def test_pruned_stiffness_keeps_a_value_that_is_not_finite(rng, bad):
+    """A position or velocity that is not finite: every row in full, the same value (NaN for a
+    NaN; an infinitely distant particle pulls with nothing)."""
+    n = 64
+    for where in (0, 3):
+        values = rng.uniform(-10.0, 10.0, (4, n))
+        values[where, 17] = bad
+        want = full_rows(*values, np.ones(n), np.ones(n), 5.0, 0.0)
+        got = pairwise.pruned_stiffness(*values, np.ones(n), np.ones(n), 5.0, 0.0, np.arange(n),
+                                        np.empty((6, n)))  # fmt: skip
+        assert got == want or (math.isnan(got) and math.isnan(want))
+        assert math.isnan(got) == math.isnan(bad)
+
+
 def test_stiffness_of_a_pair_is_its_energy_times_its_squared_rate():
     """Two charges 2 m apart closing at 3 m/s: |U| = 5 * 2 / 2, rate^2 = (9 + |U| * 2) / 4."""
     position = np.array([[-1.0, 0.0], [1.0, 0.0]])

@@ -25,6 +25,7 @@ import numpy as np
 
 from collidium.kernels.compilation import uncounted
 from collidium.kernels.floats import MAGNITUDE, bits, from_bits
+from collidium.kernels.sorting import sort_nearly_sorted
 
 #: Reassociation (partial sums per vector lane) and fused multiply-add, nothing else. The row
 #: loops also use NumPy's error model (a division by zero gives inf, as in the parallel kernel),
@@ -365,19 +366,22 @@ def stiffness_row(
     width: float,
     height: float,
     periodic: bool,
+    end: int,
 ) -> float:
-    """Largest ``(|U_ij| rate_ij^2)^2`` of row c against the rows after it
-    (`inverse_distance_stiffness`).
+    """Largest ``(|U_ij| rate_ij^2)^2`` of row c against the rows after it up to ``end``
+    (exclusive; `inverse_distance_stiffness`). A pair's value is the same bits whichever of
+    its two particles is row c, so that the maximum does not depend on the particles' order
+    (`pruned_stiffness`).
 
     Inlined into its callers, which compile it with NumPy's error model (a division by zero
     gives inf): called, with views of the callers' arrays, it cost a three-body scene 0.3 us of
     reference counting per substep."""
     xc, yc, vxc, vyc = x[c], y[c], vx[c], vy[c]
-    kqc, mc = abs(coupling * q[c]), inverse_mass[c]
+    k, qc, mc = abs(coupling), abs(q[c]), inverse_mass[c]
     # The maximum of non-negative floats as that of their bit patterns (`floats`): vectorised,
     # and a NaN is kept.
     largest = 0
-    for j in range(_u(c + 1), _u(x.shape[0])):  # unsigned: see `_tile`
+    for j in range(_u(c + 1), _u(end)):  # unsigned: see `_tile`
         dx = xc - x[j]
         dy = yc - y[j]
         if periodic:  # the same every pass: LLVM takes it out of the loop
@@ -386,11 +390,108 @@ def stiffness_row(
         inverse = 1.0 / math.sqrt(dx * dx + dy * dy + softening2)  # one division a pair
         dvx = vxc - vx[j]
         dvy = vyc - vy[j]
-        u = kqc * abs(q[j]) * inverse
+        u = k * (qc * abs(q[j])) * inverse
         w2 = dvx * dvx + dvy * dvy
         error = u * (w2 + u * (mc + inverse_mass[j])) * inverse * inverse
         largest = max(largest, bits(error * error) & MAGNITUDE)
     return from_bits(largest)
+
+
+#: Particles with a source from which `pruned_stiffness` prunes the rows; below, the pruning's
+#: sort and bounds cost more than the pairs they skip (the result is the same either way).
+PRUNE_FROM = 32
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")  # that of the inlined rows
+def pruned_stiffness(x, y, vx, vy, q, inverse_mass, coupling, softening2, order, rows) -> float:
+    """The rows' largest ``(|U_ij| rate_ij^2)^2`` (`stiffness_row`, not periodic), the pairs
+    too far apart along x to reach the largest found so far left out: the same value as every
+    row in full, from `PRUNE_FROM` particles on, in a fraction of the pairs.
+
+    The particles are taken in the order of x (``order`` (m,) sorted in place from its last
+    order, ``rows`` (6, m) the coordinates, velocities, sources and inverse masses gathered in
+    it), the neighbours in that order first. Row c then stops at the first particle whose x is
+    more than ``R`` past its own, where a pair at least that far apart errs by at most
+    ``A W s^-3 + A^2 M s^-4`` (``A = |c q_c| max|q|``, ``W = (|v_c| + max|v|)^2``,
+    ``M = 1/m_c + max 1/m``, ``s^2 = R^2 + eps^2``), half the largest each. Any value that is
+    not finite takes every row in full, where it is met."""
+    m = x.shape[0]
+    if m < PRUNE_FROM or not _all_finite(x, y, vx, vy):
+        stiffness = 0.0
+        for c in range(m):
+            row = stiffness_row(c, x, y, vx, vy, q, inverse_mass, coupling, softening2, 0.0, 0.0,
+                                False, m)  # fmt: skip
+            stiffness = larger(stiffness, row)
+        return stiffness
+    sort_nearly_sorted(order, x)
+    charge = speed = lightest = 0.0
+    for c in range(m):
+        i = order[c]
+        rows[0, c], rows[1, c], rows[2, c], rows[3, c] = x[i], y[i], vx[i], vy[i]
+        rows[4, c], rows[5, c] = q[i], inverse_mass[i]
+        charge = max(charge, abs(q[i]))
+        speed = max(speed, math.sqrt(vx[i] * vx[i] + vy[i] * vy[i]))
+        lightest = max(lightest, inverse_mass[i])
+    sx, sy, svx, svy, sq, sm = rows[0], rows[1], rows[2], rows[3], rows[4], rows[5]
+    stiffness = 0.0
+    for c in range(m - 1):  # each particle and its neighbour along x: a first largest
+        row = stiffness_row(c, sx, sy, svx, svy, sq, sm, coupling, softening2, 0.0, 0.0, False,
+                            c + 2)  # fmt: skip
+        stiffness = larger(stiffness, row)
+    for c in range(m):
+        reach = _pruning_reach(math.sqrt(stiffness), abs(coupling * sq[c]) * charge,
+                               math.sqrt(svx[c] * svx[c] + svy[c] * svy[c]) + speed,
+                               sm[c] + lightest, softening2)  # fmt: skip
+        end = _first_at_or_past(sx, c + 1, sx[c] + reach)
+        row = stiffness_row(c, sx, sy, svx, svy, sq, sm, coupling, softening2, 0.0, 0.0, False,
+                            end)  # fmt: skip
+        stiffness = larger(stiffness, row)
+    return stiffness
+
+
+#: The relative margin of `_pruning_reach`, far above the round-off of its bounds.
+_REACH_MARGIN = 1e-9
+
+
+@numba.njit(cache=True, inline="always")
+def _pruning_reach(largest, pull, speed, inverse_masses, softening2) -> float:
+    """The distance along x (m) beyond which a pair errs by less than ``largest``
+    (``|U| rate^2``, J/s^2; `pruned_stiffness`), given ``pull`` (``A``, N m^2), ``speed``
+    (``sqrt W``, m/s) and ``inverse_masses`` (``M``, 1/kg); infinite when nothing is found yet."""
+    error = largest * (1.0 - _REACH_MARGIN)
+    fly_by = pull * speed * speed
+    fall = pull * pull * inverse_masses
+    # The inverse distance that keeps each term within half the largest.
+    inverse = min(
+        (0.5 * error / fly_by) ** (1.0 / 3.0) if fly_by > 0.0 else math.inf,
+        (0.5 * error / fall) ** 0.25 if fall > 0.0 else math.inf,
+    )
+    reach2 = 1.0 / (inverse * inverse) - softening2
+    return math.sqrt(reach2) * (1.0 + _REACH_MARGIN) if reach2 > 0.0 else 0.0
+
+
+@numba.njit(cache=True, inline="always")
+def _first_at_or_past(sorted_x, first, limit) -> int:
+    """The first index from ``first`` whose value in ``sorted_x`` (ascending) is at least
+    ``limit``, or its length: a binary search."""
+    lo, hi = first, sorted_x.shape[0]
+    while lo < hi:
+        middle = (lo + hi) // 2
+        if sorted_x[middle] < limit:
+            lo = middle + 1
+        else:
+            hi = middle
+    return lo
+
+
+@numba.njit(cache=True, inline="always")
+def _all_finite(x, y, vx, vy) -> bool:
+    """Whether every coordinate and velocity is finite."""
+    for i in range(x.shape[0]):
+        if not (math.isfinite(x[i]) and math.isfinite(y[i]) and math.isfinite(vx[i])
+                and math.isfinite(vy[i])):  # fmt: skip
+            return False
+    return True
 
 
 @numba.njit(cache=True, inline="always")
@@ -432,7 +533,7 @@ def stiffness_parallel(position, velocity, source, mass, coupling, softening2, w
     for c in numba.prange((m + 1) // 2):
         for row in range(c, m - c, max(1, m - 1 - 2 * c)):  # c and m - 1 - c (once if one)
             rows[row] = stiffness_row(row, x, y, vx, vy, q, inverse_mass, coupling, softening2,
-                                      width, height, periodic)  # fmt: skip
+                                      width, height, periodic, m)  # fmt: skip
     stiffness = 0.0
     for c in range(m):
         stiffness = larger(stiffness, rows[c])
@@ -442,12 +543,17 @@ def stiffness_parallel(position, velocity, source, mass, coupling, softening2, w
 @numba.njit(cache=True, error_model="numpy")  # that of the inlined rows
 def stiffness_serial(position, velocity, source, mass, coupling, softening2, width, height,
                      periodic) -> float:  # fmt: skip
-    """`inverse_distance_stiffness`'s rows on the calling thread."""
+    """`inverse_distance_stiffness`'s rows on the calling thread, pruned where not periodic
+    (`pruned_stiffness`)."""
     x, y, vx, vy, q, inverse_mass = _moving_sources(position, velocity, source, mass)
+    m = x.shape[0]
+    if not periodic:
+        return pruned_stiffness(x, y, vx, vy, q, inverse_mass, coupling, softening2,
+                                np.argsort(x), np.empty((6, m)))  # fmt: skip
     stiffness = 0.0
-    for c in range(x.shape[0]):
+    for c in range(m):
         row = stiffness_row(c, x, y, vx, vy, q, inverse_mass, coupling, softening2, width, height,
-                             periodic)  # fmt: skip
+                             periodic, m)  # fmt: skip
         stiffness = larger(stiffness, row)
     return stiffness
 

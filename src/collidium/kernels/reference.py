@@ -103,7 +103,7 @@ def inverse_distance_stiffness(
     s2 = np.einsum("ijk,ijk->ij", d, d) + softening2
     np.fill_diagonal(s2, np.inf)  # no pair: U = 0 there
     w = v[:, None, :] - v[None, :, :]
-    u = np.abs(k * q[:, None] * q[None, :]) / np.sqrt(s2)
+    u = np.abs(k) * np.abs(q[:, None] * q[None, :]) / np.sqrt(s2)
     error = u * (np.einsum("ijk,ijk->ij", w, w) + u * (1 / m[:, None] + 1 / m[None, :])) / s2
     return float(np.max(error[np.triu_indices(q.size, 1)] ** 2, initial=0.0))
 

@@ -29,7 +29,7 @@ import numpy as np
 from collidium.kernels import events, kick_timing
 from collidium.kernels.compilation import uncounted
 from collidium.kernels.floats import largest_magnitude
-from collidium.kernels.pairwise import MOST_BLOCKS, larger, pair_sums, stiffness_row
+from collidium.kernels.pairwise import MOST_BLOCKS, pair_sums, pruned_stiffness
 from collidium.kernels.sorting import sort_nearly_sorted
 from collidium.kernels.sums import kinetic_energy, momentum, total_speed
 from collidium.kernels.vessels import BOX, CIRCLE, contacts
@@ -207,7 +207,7 @@ def smooth_intervals(
         now = origin + (elapsed + k) * dt
         total = kinetic_energy(mass, velocity) + energy
         rate2 = _squared_rate(position, velocity, mass, coupling, softening2, flows2, total,
-                              energy_floor, sources)  # fmt: skip
+                              energy_floor, sources, work[21:])  # fmt: skip
         if not dt * math.sqrt(rate2) <= most_substeps * tolerance:  # also NaN
             return k, substeps, processed, drifts
         taken = max(substeps, needed(rate2, dt, tolerance, most_substeps))
@@ -265,7 +265,8 @@ def _work(mass, source, coupling, softening2, tally):
     coordinates and velocities (m,) each, their pair sums (4, m) and the sums' buffer; the
     sweep's order and interval ends (N,) (`_meets_contact`); the pair force's law as
     `collidium.kernels.kick_timing.correct` takes it (sources (1, N), coupling and squared
-    softening (1,)); a copy of the ``tally``'s counts, impulses and heat, to put back."""
+    softening (1,)); a copy of the ``tally``'s counts, impulses and heat, to put back; the
+    order and rows of `collidium.kernels.pairwise.pruned_stiffness` (m,) and (6, m)."""
     n = mass.shape[0]
     m = 0
     for i in range(n):
@@ -284,8 +285,10 @@ def _work(mass, source, coupling, softening2, tally):
     sweep = (np.arange(n), np.empty(n), np.empty(n))
     law = (source.copy().reshape((1, n)), np.full(1, coupling), np.full(1, softening2))
     kept = (tally[0].copy(), tally[1].copy(), tally[2].copy())
+    pruning = (np.arange(m), np.empty((6, m)))
     # Concatenated: numba builds an unpacked (*a, *b) through a list, which holds one type.
-    return motion + (index, charged, inverse_mass) + rows + sums + sweep + law + kept  # noqa: RUF005
+    return (motion + (index, charged, inverse_mass) + rows + sums + sweep + law  # noqa: RUF005
+            + kept + pruning)  # fmt: skip
 
 
 @uncounted(error_model="numpy")
@@ -305,7 +308,8 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     uniform, fall, turn, region, damp = external
     log, logged = contacts[4:6]
     tally = contacts[-3:]
-    kept = work[18:]
+    kept = work[18:21]
+    order_x, rows_x = work[21:]
     engine = contacts[2] > 0  # events between re-sorts: 0 for no engine
     n = position.shape[0]
     given = 0.0
@@ -313,7 +317,7 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     flows2 = _flows2(turn, damp)
     if fastest < 0.0:
         fastest = _squared_rate(position, velocity, mass, coupling, softening2, flows2, total,
-                                energy_floor, work[3:12])  # fmt: skip
+                                energy_floor, work[3:12], work[21:])  # fmt: skip
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
@@ -365,7 +369,8 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
         given += before + after
         t = end
         rate2 = _rate(position, velocity, mass, coupling, softening2, flows2, total + given,
-                      energy_floor, index, charged, inverse_mass, x, y, vx, vy)  # fmt: skip
+                      energy_floor, index, charged, inverse_mass, x, y, vx, vy, order_x,
+                      rows_x)  # fmt: skip
         if rate2 > fastest:
             fastest = rate2
     return count + 1, t, fastest, given, processed, drifts
@@ -500,30 +505,30 @@ def _energies(position, coupling, softening2, uniform, sources) -> tuple[float, 
 
 @uncounted(error_model="numpy")
 def _squared_rate(position, velocity, mass, coupling, softening2, flows2, total, floor,
-                  sources) -> float:  # fmt: skip
-    """`_rate` with the arrays of `_work` from the indices to the sums' buffer (``sources``)."""
+                  sources, pruning) -> float:  # fmt: skip
+    """`_rate` with the arrays of `_work` from the indices to the sums' buffer (``sources``)
+    and the pruning's order and rows (``pruning``)."""
     index, charged, inverse_mass, x, y, vx, vy, _, _ = sources
+    order, rows = pruning
     return _rate(position, velocity, mass, coupling, softening2, flows2, total, floor, index,
-                 charged, inverse_mass, x, y, vx, vy)  # fmt: skip
+                 charged, inverse_mass, x, y, vx, vy, order, rows)  # fmt: skip
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")  # that of the inlined rows
 def _rate(position, velocity, mass, coupling, softening2, flows2, total, floor, index,
-          charged, inverse_mass, x, y, vx, vy) -> float:  # fmt: skip
+          charged, inverse_mass, x, y, vx, vy, order, rows) -> float:  # fmt: skip
     """`collidium.integrators._squared_rate`, 1/s^2, given the total energy (J): the square
     root of the largest ``(|U_ij| rate_ij^2)^2`` over pairs
-    (`collidium.kernels.pairwise.inverse_distance_stiffness`, by its rows, from the particles
-    with a source ``index`` gathered into ``x, y, vx, vy``) over the energy scale, or
-    ``flows2``, the velocity forces' (`_flows2`), whichever is larger."""
+    (`collidium.kernels.pairwise.pruned_stiffness`, from the particles with a source ``index``
+    gathered into ``x, y, vx, vy``, in the ``order`` of x kept from call to call) over the
+    energy scale, or ``flows2``, the velocity forces' (`_flows2`), whichever is larger."""
     for c in range(index.shape[0]):
         i = index[c]
         x[c], y[c] = position[i, 0], position[i, 1]
         vx[c], vy[c] = velocity[i, 0], velocity[i, 1]
-    stiffness = 0.0
-    for c in range(index.shape[0]):
-        row = stiffness_row(c, x, y, vx, vy, charged, inverse_mass, coupling, softening2, 0.0,
-                            0.0, False)  # fmt: skip
-        stiffness = larger(stiffness, row)
+    stiffness = pruned_stiffness(
+        x, y, vx, vy, charged, inverse_mass, coupling, softening2, order, rows
+    )
     scale = energy_scale(kinetic_energy(mass, velocity), total, floor)
     energy = math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
     return max(energy, flows2)
