@@ -241,7 +241,10 @@ def smooth_intervals(
         record[k, 3] = px
         record[k, 4] = py
         record[k, 5] = total_speed(velocity)
-        _keep_tally(tally, (counts[k], impulses[k], heats[k]))
+        for w in range(counts.shape[1]):
+            counts[k, w] = tally[0][w]
+            impulses[k, w] = tally[1][w]
+            heats[k, w] = tally[2][w]
     return count, substeps, processed, drifts
 
 
@@ -401,7 +404,7 @@ def _contact_drift(position, kicked, radius, mass, acceleration, t, h, contacts,
     return done
 
 
-@uncounted()
+@numba.njit(cache=True, inline="always")
 def _keep_tally(source, target) -> None:
     """Copy the tally's counts, impulses and heat ``source`` into ``target``."""
     counts, impulse, heat = source
