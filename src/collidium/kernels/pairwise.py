@@ -402,7 +402,7 @@ def stiffness_row(
 PRUNE_FROM = 32
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")  # that of the inlined rows
+@uncounted(error_model="numpy")  # that of the inlined rows; a call, compiled once
 def pruned_stiffness(x, y, vx, vy, q, inverse_mass, coupling, softening2, order, rows) -> float:
     """The rows' largest ``(|U_ij| rate_ij^2)^2`` (`stiffness_row`, not periodic), the pairs
     too far apart along x to reach the largest found so far left out: the same value as every
@@ -417,12 +417,7 @@ def pruned_stiffness(x, y, vx, vy, q, inverse_mass, coupling, softening2, order,
     not finite takes every row in full, where it is met."""
     m = x.shape[0]
     if m < PRUNE_FROM or not _all_finite(x, y, vx, vy):
-        stiffness = 0.0
-        for c in range(m):
-            row = stiffness_row(c, x, y, vx, vy, q, inverse_mass, coupling, softening2, 0.0, 0.0,
-                                False, m)  # fmt: skip
-            stiffness = larger(stiffness, row)
-        return stiffness
+        return every_row(x, y, vx, vy, q, inverse_mass, coupling, softening2)
     sort_nearly_sorted(order, x)
     charge = speed = lightest = 0.0
     for c in range(m):
@@ -445,6 +440,18 @@ def pruned_stiffness(x, y, vx, vy, q, inverse_mass, coupling, softening2, order,
         end = _first_at_or_past(sx, c + 1, sx[c] + reach)
         row = stiffness_row(c, sx, sy, svx, svy, sq, sm, coupling, softening2, 0.0, 0.0, False,
                             end)  # fmt: skip
+        stiffness = larger(stiffness, row)
+    return stiffness
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")  # that of the inlined rows
+def every_row(x, y, vx, vy, q, inverse_mass, coupling, softening2) -> float:
+    """The largest of every row in full (`stiffness_row`, not periodic): what
+    `pruned_stiffness` gives, inlined where the particles are few."""
+    stiffness = 0.0
+    for c in range(x.shape[0]):
+        row = stiffness_row(c, x, y, vx, vy, q, inverse_mass, coupling, softening2, 0.0, 0.0,
+                            False, x.shape[0])  # fmt: skip
         stiffness = larger(stiffness, row)
     return stiffness
 
