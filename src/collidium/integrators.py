@@ -409,18 +409,18 @@ class AdaptiveLeapfrog(Integrator):
         fastest: float,
         total: float,
     ) -> tuple[float, bool]:
-        """Take the interval in ``n`` regular substeps, those that meet no contact by the
-        compiled ``flight`` where there is one. Returns the largest squared rate (1/s^2) met at
-        their boundaries, starting from ``fastest``, the interval's start's (`_squared_rate`,
-        with the ``total`` energy J at the start and the energy given since: by the velocity
-        forces, the walls, a piston and inelastic collisions); and whether a substep met a
-        contact."""
+        """Take the interval in ``n`` regular substeps, those the compiled ``flight`` takes by
+        it where there is one (`_SmoothFlight.substeps`), the rest in Python (`_substep`).
+        Returns the largest squared rate (1/s^2) met at their boundaries, starting from
+        ``fastest``, the interval's start's (`_squared_rate`, with the ``total`` energy J at the
+        start and the energy given since: by the velocity forces, the walls, a piston and
+        inelastic collisions); and whether a substep taken in Python met a contact."""
         t = now
         met = False
         given = _given(tally)
         s = 1
         while s <= n:
-            if flight is not None:  # as many substeps as meet no contact, compiled
+            if flight is not None:  # as many substeps as it takes, compiled
                 now_total = total + (_given(tally) - given)
                 s, t, fastest, drag = flight.substeps(particles, field, tally, now, dt, s, n, t,
                                                       fastest, now_total)  # fmt: skip
