@@ -164,11 +164,6 @@ class ContactLog:
         """Rows for twice as many contacts as were met (a drift taken again logs them all)."""
         self.rows = np.empty((2 * int(self.count[0]), events.LOG_COLUMNS))
 
-    @property
-    def contacts(self) -> FloatArray:
-        """The rows of the contacts logged."""
-        return self.rows[: min(int(self.count[0]), self.rows.shape[0])]
-
 
 @dataclass(frozen=True, eq=False)
 class SubstepEngine:

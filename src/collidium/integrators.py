@@ -274,6 +274,9 @@ class AdaptiveLeapfrog(Integrator):
         #: cost its substeps up to the contact twice), or `fly` found that it meets one.
         self.next_in_python = False
         self._log = ContactLog()
+        #: The record of a single interval compiled whole by `step`, not read but for the drag's
+        #: heat (made again for a vessel of another number of walls).
+        self._one: FlightRecord | None = None
 
     def state(self) -> dict[str, np.ndarray]:
         """The substep count the next interval starts with, and whether it is taken in Python
@@ -307,7 +310,7 @@ class AdaptiveLeapfrog(Integrator):
         flight = self._flight_for(particles, vessel, field, drift)
         tried = flight is not None and not self.next_in_python
         if tried and self._intervals(typing.cast(_SmoothFlight, flight), particles, field, now,
-                                     0, dt, tally, FlightRecord.empty(tally, _ONE)):  # fmt: skip
+                                     0, dt, tally, self._one_record(tally)):  # fmt: skip
             return  # compiled whole
         start = _Snapshot(particles, tally)
         # The energy the substeps' rate is judged against: the interval's one read of the
@@ -342,6 +345,12 @@ class AdaptiveLeapfrog(Integrator):
             field.evaluate(particles, vessel)
             n = max(required, 2 * n)
         self.substeps = max(1, n // 2) if required <= n // 2 else n
+
+    def _one_record(self, tally: Tally) -> FlightRecord:
+        """The record of one interval, kept while the tally's size stays the same."""
+        if self._one is None or self._one.counts.shape[1] != tally.counts.shape[0]:
+            self._one = FlightRecord.empty(tally, np.ones(1, dtype=bool))
+        return self._one
 
     def _flight_for(
         self, particles: Particles, vessel: Vessel, field: ForceField, drift: Drift
@@ -700,10 +709,6 @@ class _SmoothFlight:
         )  # fmt: skip
         self._took(processed, drifts)
         return int(s), float(reached), float(rate2), float(drag)
-
-
-#: Which rows of a single compiled interval's record are read (`AdaptiveLeapfrog._with_forces`).
-_ONE = np.ones(1, dtype=bool)
 
 
 class _Snapshot:
