@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numba
@@ -203,6 +204,27 @@ def test_pruned_stiffness_is_every_row_bit_for_bit(rng, softening2):
             got = pairwise.pruned_stiffness(x, y, vx, vy, q, inverse_mass, 5.0, softening2, order,
                                             np.empty((6, n)))  # fmt: skip
             assert got == want and np.all(np.diff(x[order]) >= 0.0)  # left sorted
+
+
+def test_pruned_stiffness_finds_the_largest_pair_past_its_neighbours_along_x(rng):
+    """The hardest pair is not a pair of neighbours along x (disks lie between them in x, far
+    away in y), so the first largest is small and the bound shrinks as the rows find larger
+    ones: still the same bits as every row, from any order."""
+    n = 100
+    x, y = np.linspace(-10.0, 10.0, n), np.where(np.arange(n) % 2 == 0, 6.0, -6.0)
+    vx, vy = np.zeros(n), np.zeros(n)
+    x[:2], y[:2], vx[:2] = [0.0, 0.4], [0.0, 0.3], [100.0, -100.0]  # 0.5 m apart, closing fast
+    x[2:6], y[2:6] = [0.1, 0.2, 0.3, 0.35], [8.0, -8.0, 9.0, -9.0]
+    q, inverse_mass = np.ones(n), np.ones(n)
+    want = full_rows(x, y, vx, vy, q, inverse_mass, 5.0, 0.0)
+    pairs = [list(pair) for pair in itertools.pairwise(np.argsort(x))]
+    neighbours = max(full_rows(x[pair], y[pair], vx[pair], vy[pair], q[pair], inverse_mass[pair],
+                               5.0, 0.0) for pair in pairs)  # fmt: skip
+    assert neighbours < want / 100  # the first largest is far from the pair's
+    for order in (np.arange(n), rng.permutation(n)):
+        got = pairwise.pruned_stiffness(x, y, vx, vy, q, inverse_mass, 5.0, 0.0, order,
+                                        np.empty((6, n)))  # fmt: skip
+        assert got == want
 
 
 @pytest.mark.parametrize("bad", [math.inf, math.nan])

@@ -412,9 +412,10 @@ def pruned_stiffness(x, y, vx, vy, q, inverse_mass, coupling, softening2, order,
     order, ``rows`` (6, m) the coordinates, velocities, sources and inverse masses gathered in
     it), the neighbours in that order first. Row c then stops at the first particle whose x is
     more than ``R`` past its own, where a pair at least that far apart errs by at most
-    ``A W s^-3 + A^2 M s^-4`` (``A = |c q_c| max|q|``, ``W = (|v_c| + max|v|)^2``,
-    ``M = 1/m_c + max 1/m``, ``s^2 = R^2 + eps^2``), half the largest each. Any value that is
-    not finite takes every row in full, where it is met."""
+    ``A W s^-3 + A^2 M s^-4`` (``A = |c| max|q|^2``, ``W = (2 max|v|)^2``, ``M = 2 max 1/m``,
+    ``s^2 = R^2 + eps^2``), half the largest each. ``R`` is the same for every row, found again
+    only when the largest grows: its roots cost more than the few pairs a bound of each row's
+    own would leave out. Any value that is not finite takes every row in full, where it is met."""
     m = x.shape[0]
     if m < PRUNE_FROM or not _all_finite(x, y, vx, vy):
         return every_row(x, y, vx, vy, q, inverse_mass, coupling, softening2)
@@ -433,14 +434,15 @@ def pruned_stiffness(x, y, vx, vy, q, inverse_mass, coupling, softening2, order,
         row = stiffness_row(c, sx, sy, svx, svy, sq, sm, coupling, softening2, 0.0, 0.0, False,
                             c + 2)  # fmt: skip
         stiffness = larger(stiffness, row)
+    pull, fastest, masses = abs(coupling) * charge * charge, 2.0 * speed, 2.0 * lightest
+    reach = _pruning_reach(math.sqrt(stiffness), pull, fastest, masses, softening2)
     for c in range(m):
-        reach = _pruning_reach(math.sqrt(stiffness), abs(coupling * sq[c]) * charge,
-                               math.sqrt(svx[c] * svx[c] + svy[c] * svy[c]) + speed,
-                               sm[c] + lightest, softening2)  # fmt: skip
         end = _first_at_or_past(sx, c + 1, sx[c] + reach)
         row = stiffness_row(c, sx, sy, svx, svy, sq, sm, coupling, softening2, 0.0, 0.0, False,
                             end)  # fmt: skip
-        stiffness = larger(stiffness, row)
+        if not row <= stiffness:  # larger, or NaN
+            stiffness = larger(stiffness, row)
+            reach = _pruning_reach(math.sqrt(stiffness), pull, fastest, masses, softening2)
     return stiffness
 
 

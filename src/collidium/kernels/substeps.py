@@ -239,7 +239,8 @@ def smooth_intervals(
         substeps = max(1, taken // 2) if required <= taken // 2 else taken
         given += drag
         heat[k] = given
-        energy, virial = _energies(position, coupling, softening2, uniform, sources)
+        # The last substep's pair sums are of the positions now.
+        energy, virial = _summed_energies(position, uniform, work[10])
         px, py = momentum(mass, velocity)
         record[k, 0] = kinetic_energy(mass, velocity)
         record[k, 1] = energy
@@ -493,14 +494,22 @@ def _accelerations(position, mass, coupling, softening2, uniform, fall, index, c
 
 @uncounted(error_model="numpy")
 def _energies(position, coupling, softening2, uniform, sources) -> tuple[float, float]:
-    """The potential energy and the pair virial (J) as `collidium.forces.base.ForceField` sums
-    them, force by force: the pair force's pair sums halved to the particles and summed in
-    particle order (`collidium.kernels.sums.ordered_sum`; the particles without a source add
-    nothing), and the ``uniform`` field's ``-F_i . x_i`` in particle order
-    (`collidium.forces.uniform`; no virial). Two sums added to 0 in either order give the same
-    bits. ``sources``: the arrays of `_work` from the indices to the sums' buffer."""
+    """The potential energy and the pair virial (J) of the positions (`_summed_energies`), their
+    pair sums taken here. ``sources``: the arrays of `_work` from the indices to the sums'
+    buffer."""
     index, charged, _, x, y, _, _, sums, buffer = sources
     _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffer)
+    return _summed_energies(position, uniform, sums)
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _summed_energies(position, uniform, sums) -> tuple[float, float]:
+    """The potential energy and the pair virial (J) as `collidium.forces.base.ForceField` sums
+    them, force by force, from the pair sums (4, m) of the positions: those halved to the
+    particles and summed in particle order (`collidium.kernels.sums.ordered_sum`; the particles
+    without a source add nothing), and the ``uniform`` field's ``-F_i . x_i`` in particle order
+    (`collidium.forces.uniform`; no virial). Two sums added to 0 in either order give the same
+    bits."""
     energy = 0.0
     virial = 0.0
     for c in range(sums.shape[1]):
