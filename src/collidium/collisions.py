@@ -201,10 +201,9 @@ class SubstepEngine:
         that the compiled substeps compile once: they leave every substep that meets a contact
         to Python."""
         arrays = _engine_arrays(1, 1)
-        geometry, grid = np.zeros(events.GEOMETRY_SIZE), np.zeros(3, dtype=np.int64)
-        queue = (*(arrays[name] for name in ("body",)), geometry, grid,
-                 *(arrays[name] for name in ("head", "next", "event", "keys", "items")),
-                 vessel.segments(), np.empty(0))  # fmt: skip
+        arrays["geometry"] = np.zeros(events.GEOMETRY_SIZE)
+        arrays["grid"] = np.zeros(3, dtype=np.int64)
+        queue = (*(arrays[name] for name in _QUEUE_ARRAYS), vessel.segments(), np.empty(0))
         return cls(queue, vessel.wall_table(), 0, 0.0, ContactLog(0), ExactCollisions())
 
     def took(self, processed: int, drifts: int) -> None:
@@ -659,6 +658,10 @@ class ExactCollisions:
         s["grid"] = np.array([ncx, ncy, int(vessel.periodic)], dtype=np.int64)
         return s
 
+    def _sort_every(self, n: int) -> int:
+        """Events between re-sorts of the slots for n particles (`sort_interval` a particle)."""
+        return max(1, self.sort_interval * n)
+
     def substep_engine(self, particles: Particles, vessel: Vessel) -> SubstepEngine | None:
         """An engine of its own for the compiled substeps' drifts that meet contacts
         (`collidium.kernels.substeps`), which build its queue afresh at each; None where they
@@ -671,7 +674,7 @@ class ExactCollisions:
         return SubstepEngine(
             (*(s[name] for name in _QUEUE_ARRAYS), vessel.segments(), s["piston"]),
             vessel.wall_table(),
-            max(1, self.sort_interval * particles.n),
+            self._sort_every(particles.n),
             _runaway_reach(vessel),
             ContactLog(max(64, 4 * particles.n)),
             self,
@@ -703,7 +706,7 @@ class ExactCollisions:
             until, s["body"], particles.image, s["geometry"], s["grid"], s["head"], s["next"],
             s["event"], s["keys"], s["items"], tally.counts, tally.impulse,
             _NO_ACCELERATION if acceleration is None else acceleration, now + 0.5 * dt,
-            max(1, self.sort_interval * particles.n), log.rows, log.count, vessel.wall_table(),
+            self._sort_every(particles.n), log.rows, log.count, vessel.wall_table(),
             tally.heat, vessel.segments(), s["piston"],
         )  # fmt: skip
         if processed < 0:
@@ -760,7 +763,7 @@ class ExactCollisions:
         taken, processed, ending = event_flights.event_intervals(
             origin, elapsed, dt, record.values.shape[0], s["body"], p.image, s["geometry"],
             s["grid"], s["head"], s["next"], s["event"], s["keys"], s["items"], tally.counts,
-            tally.impulse, _NO_ACCELERATION, max(1, self.sort_interval * p.n),
+            tally.impulse, _NO_ACCELERATION, self._sort_every(p.n),
             self._unlogged.rows, self._unlogged.count, vessel.wall_table(), tally.heat,
             vessel.segments(), s["piston"], p.position,
             p.velocity, writable(p.mass), writable(p.radius), fall_x, fall_y, width, height,
