@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from collidium import Box, Circle, Gravity, Particles, Simulation, collisions
-from collidium.kernels import cells, events, reference
+from collidium.kernels import audit, cells, events, reference
 from collidium.kernels.events import contact_delay
 from lattices import jittered_lattice
 
@@ -285,3 +285,13 @@ def test_engine_matches_twin_across_cell_crossings(rng):
     assert pairs >= 2
     assert (sim.counters.pair_collisions, sim.counters.wall_collisions) == (pairs, walls)
     np.testing.assert_allclose(sim.unwrapped_position(), twin_position, rtol=0, atol=1e-9 * width)
+
+
+@pytest.mark.parametrize(
+    "kernel",
+    [events.rebuild, events.run_events, events.synchronise, events.matches, audit._in_chunks],
+)
+def test_the_engine_lets_other_threads_run_while_it_works(kernel):
+    """The viewer's server reads and sends while a step of a large gas runs in its worker thread
+    (ARCHITECTURE.md, "The viewer's frames"): the step's kernels release Python's lock."""
+    assert kernel.targetoptions.get("nogil") is True

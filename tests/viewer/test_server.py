@@ -132,6 +132,19 @@ def test_a_server_open_to_the_network_accepts_its_own_pages_under_any_name():
         assert receive_json(ws)["type"] == "hello"
 
 
+def test_frames_go_uncompressed_to_a_page_that_offers_compression():
+    """Compressing a 1e5-disk frame took longer than drawing it (ARCHITECTURE.md, "The viewer's
+    frames")."""
+    from websockets.sync.client import connect
+
+    app = create_app(lambda: ViewerSession(preset("gas", n=5)))
+    with running(app) as url, connect(url.replace("http", "ws") + "ws") as ws:
+        assert "permessage-deflate" in ws.request.headers["Sec-WebSocket-Extensions"]
+        assert "Sec-WebSocket-Extensions" not in ws.response.headers
+        ws.send(json.dumps({"type": "ready"}))
+        assert json.loads(ws.recv(timeout=30))["type"] == "hello"
+
+
 @pytest.mark.parametrize(
     "path",
     ["/static/../server.py", "/static/%2e%2e/server.py", "/static/..%2f..%2fcli.py",

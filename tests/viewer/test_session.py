@@ -50,6 +50,15 @@ def test_advance_gives_up_time_it_cannot_afford_and_never_runs_while_paused(gas)
     assert gas.sim.steps == 1
 
 
+def test_advance_spends_the_nearest_whole_number_of_steps_to_its_budget(gas):
+    gas._seconds_per_step = 0.6  # a step just over half the budget: two fit it best
+    gas.advance(0.2, budget=1.0)
+    assert gas.sim.steps == 2
+    gas._seconds_per_step = 0.9  # but not a third, which would overspend it by 35%
+    gas.advance(0.2, budget=2.0)
+    assert gas.sim.steps == 4
+
+
 def test_heat_multiplies_the_kinetic_energy_and_restarts_the_drift(gas):
     before = gas.sim.energy().kinetic
     gas.heat(1.25)

@@ -95,7 +95,7 @@ def all_valid(position, velocity, radius, shape, limit_x, limit_y, slack, period
     return not bad
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, nogil=True)
 def _in_chunks(position, velocity, radius, shape, limit_x, limit_y, slack, periodic, segments):
     """`first_invalid` in parallel chunks: each finds its first, the earliest chunk's wins."""
     n = position.shape[0]

@@ -617,7 +617,7 @@ def sort_slots(body, cell_of, event, head, next_, items, where) -> None:
     _link_cells(cell_of, head, next_)
 
 
-@uncounted()
+@uncounted(nogil=True)
 def rebuild(now, body, geometry, grid, head, next_, event, keys, items, segments, piston) -> None:
     """Start a fresh queue at time ``now`` (s) from positions synchronised at ``now``.
 
@@ -648,7 +648,7 @@ def rebuild(now, body, geometry, grid, head, next_, event, keys, items, segments
 # --- the drift ----------------------------------------------------------------------------------
 
 
-@uncounted()
+@uncounted(nogil=True)
 def run_events(
     until: float,
     body: np.ndarray,
@@ -1006,7 +1006,7 @@ def load(position, velocity, radius, mass, body, event) -> None:
         event[i, IDENT] = i
 
 
-@uncounted()
+@uncounted(nogil=True)
 def synchronise(now, body, event, geometry, grid, position, velocity) -> int:
     """Write every particle's position at time ``now`` (s) and velocity into ``position`` and
     ``velocity`` (N, 2), by particle; the lazily kept state is untouched so the queue stays
@@ -1027,7 +1027,7 @@ def synchronise(now, body, event, geometry, grid, position, velocity) -> int:
     return strays
 
 
-@uncounted()
+@uncounted(nogil=True)
 def matches(now, body, event, geometry, position, velocity, radius, mass) -> bool:
     """True if the particles are exactly what `synchronise` wrote at ``now`` (s), with the
     engine's radii and masses: nobody changed them since, and the queue is still valid."""
