@@ -537,6 +537,17 @@ def test_view_refuses_bad_input_in_one_line(args, line):
     assert result.stderr.startswith(line) and result.stderr.count("\n") == 1
 
 
+def _ends_within(process: subprocess.Popen[str], seconds: float) -> tuple[str, str]:
+    """What ``process`` wrote, once it has ended within ``seconds``; else it is killed (not left
+    running beside the rest of the suite) and the test fails."""
+    try:
+        return process.communicate(timeout=seconds)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.communicate()
+        raise
+
+
 def test_view_serves_the_page_until_interrupted():
     import urllib.request
 
@@ -554,7 +565,7 @@ def test_view_serves_the_page_until_interrupted():
         assert taken.returncode == 2 and "error: --port: cannot listen" in taken.stderr
     finally:
         process.send_signal(signal.SIGINT)
-        _, rest = process.communicate(timeout=20)
+        _, rest = _ends_within(process, 20)
     assert process.returncode == 0
     assert "Traceback" not in rest
 
@@ -571,7 +582,7 @@ def test_view_warns_when_it_listens_beyond_this_machine():
         assert process.stderr.readline().startswith("collidium viewer at http://127.0.0.1:")
     finally:
         process.send_signal(signal.SIGINT)
-        process.communicate(timeout=20)
+        _ends_within(process, 20)
 
 
 def test_energy_drift_warns_and_max_drift_fails_the_run():
@@ -623,7 +634,7 @@ def test_ctrl_c_says_where_the_run_stopped_and_what_it_kept(tmp_path):
     while not (tmp_path / "r.ckpt").exists() and time.monotonic() < deadline:
         time.sleep(0.05)
     process.send_signal(signal.SIGINT)
-    _, stderr = process.communicate(timeout=120)
+    _, stderr = _ends_within(process, 120)
     assert process.returncode == 130
     assert stderr.count("\n") == 1 and stderr.startswith("error: interrupted at step "), stderr
     from collidium.io.trajectory import read_trajectory

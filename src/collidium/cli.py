@@ -20,7 +20,7 @@ import typer
 from pydantic import ValidationError
 
 from collidium.errors import InputError, Interrupted, SimulationError
-from collidium.kernels.compilation import on_first_compile
+from collidium.kernels.compilation import interrupts_outside_compiling, on_first_compile
 
 if TYPE_CHECKING:
     from collidium.runner import Job
@@ -741,7 +741,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     quiet = "--quiet" in args or "-q" in args or not sys.stderr.isatty()
     notice = nullcontext() if quiet else on_first_compile(_compiling_notice)
     try:
-        with notice:
+        with notice, interrupts_outside_compiling():
             result = command.main(
                 args=args,
                 prog_name="collidium",

@@ -6,13 +6,16 @@ from __future__ import annotations
 import importlib
 import inspect
 import pkgutil
+import signal
 from typing import Any
 
 import numba
+import pytest
+from numba.core import event as numba_event
 from numba.core.registry import CPUDispatcher as Dispatcher
 
 import collidium.kernels
-from collidium.kernels.compilation import on_first_compile
+from collidium.kernels.compilation import interrupts_outside_compiling, on_first_compile
 
 
 def _fresh_kernel():
@@ -23,6 +26,34 @@ def _fresh_kernel():
         return 2 * x
 
     return twice
+
+
+class _InterruptAtCompile(numba_event.Listener):
+    """Presses Ctrl+C as numba starts compiling."""
+
+    def on_start(self, event: numba_event.Event) -> None:
+        signal.raise_signal(signal.SIGINT)
+
+    def on_end(self, event: numba_event.Event) -> None:
+        pass
+
+
+def test_a_ctrl_c_during_a_compile_is_raised_once_the_kernel_is_whole():
+    """Raised inside numba's compiler, the interrupt would leave the kernel half made (no
+    signature; in the engine, libraries that the next kernel fails to link)."""
+    kernel = _fresh_kernel()
+    listener = _InterruptAtCompile()
+    numba_event.register("numba:compile", listener)
+    try:
+        with interrupts_outside_compiling(), pytest.raises(KeyboardInterrupt):
+            kernel(1.0)
+    finally:
+        numba_event.unregister("numba:compile", listener)
+    assert len(kernel.signatures) == 1
+    assert kernel(2.0) == 4.0
+    with interrupts_outside_compiling(), pytest.raises(KeyboardInterrupt):
+        signal.raise_signal(signal.SIGINT)  # outside a compile: at once
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # put back
 
 
 def test_the_callback_runs_once_at_the_first_compile_and_not_after_the_block():

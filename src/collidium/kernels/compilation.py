@@ -3,13 +3,17 @@ on a laptop, silent otherwise); later runs load them from the cache in well unde
 
 numba announces each real compilation, and not a load from its cache, as a ``numba:compile``
 event (its event API); `on_first_compile` turns the first such event into one call, so that a
-command line can say at once why nothing happens yet.
+command line can say at once why nothing happens yet. `interrupts_outside_compiling` holds a
+Ctrl+C back while numba compiles or loads a kernel, which it cannot survive.
 """
 
 from __future__ import annotations
 
+import signal
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from types import FrameType
 from typing import Any
 
 import numba
@@ -67,3 +71,50 @@ def on_first_compile(callback: Callable[[], None]) -> Iterator[None]:
         yield
     finally:
         numba_event.unregister("numba:compile", listener)
+
+
+class _CompilerDepth(numba_event.Listener):
+    """How deep the main thread is in numba's compiler lock (held while numba compiles a kernel
+    or loads one from its cache); raises a Ctrl+C held back meanwhile once it has left it."""
+
+    def __init__(self) -> None:
+        self.depth = 0
+        self.held = False
+
+    def on_start(self, event: numba_event.Event) -> None:
+        if threading.current_thread() is threading.main_thread():
+            self.depth += 1
+
+    def on_end(self, event: numba_event.Event) -> None:
+        if threading.current_thread() is not threading.main_thread():
+            return
+        self.depth -= 1
+        if self.depth == 0 and self.held:  # the lock is released: numba is whole again
+            self.held = False
+            raise KeyboardInterrupt
+
+
+@contextmanager
+def interrupts_outside_compiling() -> Iterator[None]:
+    """Within the block (entered on the main thread), a Ctrl+C (SIGINT) that arrives while numba
+    compiles or loads a kernel is raised as soon as it is done, not inside it: interrupted there,
+    numba keeps a half-made library, and the next kernel that links it fails with a traceback
+    (``RuntimeError: no compiled object yet``). Elsewhere a Ctrl+C raises at once, as usual."""
+    if threading.current_thread() is not threading.main_thread():  # signals go to the main one
+        yield
+        return
+    depth = _CompilerDepth()
+
+    def on_interrupt(signum: int, frame: FrameType | None) -> None:
+        if depth.depth > 0:
+            depth.held = True
+        else:
+            raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, on_interrupt)
+    numba_event.register("numba:compiler_lock", depth)
+    try:
+        yield
+    finally:
+        numba_event.unregister("numba:compiler_lock", depth)
+        signal.signal(signal.SIGINT, previous)
