@@ -203,7 +203,8 @@ class SubstepEngine:
         arrays = _engine_arrays(1, 1)
         arrays["geometry"] = np.zeros(events.GEOMETRY_SIZE)
         arrays["grid"] = np.zeros(3, dtype=np.int64)
-        queue = (*(arrays[name] for name in _QUEUE_ARRAYS), vessel.segments(), np.empty(0))
+        arrays["piston"] = np.empty(0)
+        queue = _queue(arrays, vessel)
         return cls(queue, vessel.wall_table(), 0, 0.0, ContactLog(0), ExactCollisions())
 
     def took(self, processed: int, drifts: int) -> None:
@@ -627,7 +628,7 @@ class ExactCollisions:
             if piston.size
             else np.empty(0)
         )
-        events.rebuild(now, *(s[name] for name in _QUEUE_ARRAYS), vessel.segments(), s["piston"])
+        events.rebuild(now, *_queue(s, vessel))
         return s
 
     def _layout(
@@ -672,7 +673,7 @@ class ExactCollisions:
         s = self._layout(particles, vessel, _NO_FALL)
         s["piston"] = np.empty(0)
         return SubstepEngine(
-            (*(s[name] for name in _QUEUE_ARRAYS), vessel.segments(), s["piston"]),
+            _queue(s, vessel),
             vessel.wall_table(),
             self._sort_every(particles.n),
             _runaway_reach(vessel),
@@ -905,3 +906,9 @@ _SLOT_VIEWS = {
 #: The engine's arrays in the order `events.rebuild` takes them (the slot views are taken there,
 #: from ``event``).
 _QUEUE_ARRAYS = ("body", "geometry", "grid", "head", "next", "event", "keys", "items")
+
+
+def _queue(state: dict[str, np.ndarray], vessel: Vessel) -> tuple[np.ndarray, ...]:
+    """The engine's arrays of ``state`` in the order `collidium.kernels.events.rebuild` takes
+    them, then the vessel's segments and the state's piston."""
+    return (*(state[name] for name in _QUEUE_ARRAYS), vessel.segments(), state["piston"])

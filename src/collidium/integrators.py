@@ -566,9 +566,8 @@ class _SmoothFlight:
     and region, a drag's rates), the walls as the exact engine has them, and under exact
     collisions an engine of its own for the substeps that meet contacts
     (`collidium.collisions.ExactCollisions.substep_engine`; a disabled one where Python takes
-    them). The
-    integrator keeps it while it `fits`: making it is most of the Python work of a small scene's
-    reporting interval."""
+    them). The integrator keeps it while it `fits`: making it is most of the Python work of a
+    small scene's reporting interval."""
 
     vessel: Vessel
     field: ForceField
@@ -673,9 +672,9 @@ class _SmoothFlight:
                 tally.heat)  # fmt: skip
 
     def _took(self, processed: int, drifts: int) -> None:
-        """Count the engine's events and queue builds in the compiled substeps."""
-        if self.takes_contacts:
-            self.engine.took(int(processed), int(drifts))
+        """Count the engine's events and queue builds in the compiled substeps (none for a
+        disabled engine)."""
+        self.engine.took(int(processed), int(drifts))
 
     def squared_rate(
         self, particles: Particles, field: ForceField, tally: Tally, total: float
