@@ -1,4 +1,5 @@
-"""Build hook: bundle the viewer's front end (``frontend/``) into the package with npm.
+"""Build hook: bundle the viewer's front end (``frontend/``) into the package with npm, and
+put the presets' compiled kernels into the wheel.
 
 ``pip install .`` from a clone, every wheel and every sdist get ``src/collidium/viewer/static/
 {app,widget}.{js,css}``, built by esbuild from the sources and the locked npm dependencies
@@ -6,6 +7,13 @@
 missing or older than a source, so a wheel built from an sdist needs no Node.js. Building from a
 clone needs Node.js (>= 18) and npm; ``COLLIDIUM_SKIP_FRONTEND=1`` builds without the viewer
 (``collidium view`` then says the front end is missing).
+
+A wheel (not an editable install) also carries numba's cache of the kernels that the presets
+run (``python -m collidium.precompile``, run on a copy of the package in the build's
+environment, which holds collidium's dependencies for it), so that the first run after ``pip
+install .`` loads them instead of compiling them. numba keys its cache by the source's content,
+its own version and the CPU, so a wheel used elsewhere, or with another numba, compiles on its
+first run as without it. ``COLLIDIUM_PRECOMPILE=0`` builds without it (a wheel to publish).
 """
 
 from __future__ import annotations
@@ -14,6 +22,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -22,12 +31,23 @@ from hatchling.builders.hooks.plugin.interface import BuildHookInterface
 BUNDLES = ("app.js", "app.css", "widget.js", "widget.css")
 
 
-class FrontEndBuildHook(BuildHookInterface):  # type: ignore[type-arg]
-    """Runs ``npm ci`` and ``npm run build`` in ``frontend/`` before a wheel or sdist is made."""
+class BuildHook(BuildHookInterface):  # type: ignore[type-arg]
+    """Bundles the front end before a wheel or sdist is made; compiles the kernels into a wheel."""
 
     PLUGIN_NAME = "custom"
 
     def initialize(self, version: str, build_data: dict[str, Any]) -> None:
+        self._bundle_front_end(build_data)
+        self._compiled: Path | None = None
+        if self.target_name == "wheel" and version == "standard":
+            self._compiled = _precompile(Path(self.root) / "src" / "collidium", build_data)
+
+    def finalize(self, version: str, build_data: dict[str, Any], artifact_path: str) -> None:
+        if getattr(self, "_compiled", None) is not None:
+            shutil.rmtree(self._compiled, ignore_errors=True)
+
+    def _bundle_front_end(self, build_data: dict[str, Any]) -> None:
+        """Runs ``npm ci`` and ``npm run build`` in ``frontend/`` where the bundles are stale."""
         root = Path(self.root)
         frontend = root / "frontend"
         static = root / "src" / "collidium" / "viewer" / "static"
@@ -40,6 +60,31 @@ class FrontEndBuildHook(BuildHookInterface):  # type: ignore[type-arg]
                 return
             _bundle(frontend)
         build_data["artifacts"] += [str(path.relative_to(root)) for path in outputs]
+
+
+def _precompile(package: Path, build_data: dict[str, Any]) -> Path | None:
+    """Compile the presets' kernels on a copy of ``package`` and add numba's cache files to the
+    wheel (``force_include``); returns the copy's folder, to remove once the wheel is written.
+    A failure leaves the wheel without them (its first run compiles), with a line saying why."""
+    if os.environ.get("COLLIDIUM_PRECOMPILE") == "0":
+        sys.stderr.write("collidium: COLLIDIUM_PRECOMPILE=0, building without compiled kernels\n")
+        return None
+    folder = Path(tempfile.mkdtemp(prefix="collidium-kernels-"))
+    copy = folder / "collidium"
+    shutil.copytree(package, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    environment = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    environment["PYTHONPATH"] = str(folder)  # the copy, whose own __pycache__ numba fills
+    result = subprocess.run(
+        [sys.executable, "-m", "collidium.precompile"],
+        cwd=folder, env=environment, capture_output=True, text=True,
+    )  # fmt: skip
+    if result.returncode != 0:
+        reason = (result.stderr.strip().splitlines() or ["no output"])[-1]
+        sys.stderr.write(f"collidium: building without compiled kernels: {reason}\n")
+        return folder
+    for path in sorted(copy.rglob("__pycache__/*.nb[ic]")):
+        build_data["force_include"][str(path)] = f"collidium/{path.relative_to(copy).as_posix()}"
+    return folder
 
 
 def _sources(frontend: Path) -> list[Path]:

@@ -1,0 +1,59 @@
+"""Compile the kernels every preset runs into numba's cache: ``python -m collidium.precompile``.
+
+pip runs this when it builds collidium's wheel (``hatch_build.py``), so that the wheel carries
+the compiled kernels and the first run after installing loads them instead of compiling them
+for half a minute. Run it by hand to fill a cache of your own, such as a ``NUMBA_CACHE_DIR``
+that a cluster's workers share before a sweep. Given preset names, it compiles for those alone.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+
+from collidium.presets import PRESETS, preset
+from collidium.runner import execute, prepare
+
+#: Steps each preset runs: enough for the compiled flights between the summary's readings.
+STEPS = 20
+
+
+def precompile(names: list[str], steps: int = STEPS) -> None:
+    """Run each preset in ``names`` for ``steps`` steps, as ``collidium run`` does, so that numba
+    compiles and caches every kernel they call."""
+    for name in names:
+        sim, job = prepare(preset(name), steps=steps)
+        execute(sim, job)
+
+
+def groups(workers: int) -> list[list[str]]:
+    """The presets in ``workers`` groups (at most two: the neutral ones, whose kernels are the
+    exact engine's, and those under forces), to compile side by side."""
+    if workers < 2:
+        return [list(PRESETS)]
+    forced = {name: bool(preset(name).forces) for name in PRESETS}
+    return [[name for name in PRESETS if forced[name] == group] for group in (False, True)]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Precompile the presets named (in this process), or every preset in a process per group
+    (`groups`), saying how long it took."""
+    names = sys.argv[1:] if argv is None else argv
+    start = time.perf_counter()
+    if names:
+        precompile(names)
+        return 0
+    command = [sys.executable, "-m", "collidium.precompile"]
+    workers = [subprocess.Popen(command + group) for group in groups(os.cpu_count() or 1)]
+    failed = [worker.args for worker in workers if worker.wait() != 0]
+    if failed:
+        sys.stderr.write(f"collidium: precompiling failed: {failed}\n")
+        return 1
+    sys.stderr.write(f"collidium: kernels compiled in {time.perf_counter() - start:.0f} s\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,43 @@
+"""Precompiling the presets' kernels (`collidium.precompile`)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from collidium.precompile import groups
+from collidium.presets import PRESETS, preset
+
+#: Runs the command line in-process, then says how many kernels numba compiled (not loaded).
+COUNT_COMPILED = """
+import gc, sys
+import numba.core.registry
+from collidium.cli import main
+code = main(sys.argv[1:])
+print("COMPILED", sum(sum(d.stats.cache_misses.values()) for d in gc.get_objects()
+                      if isinstance(d, numba.core.registry.CPUDispatcher)))
+sys.exit(code)
+"""
+
+
+def test_two_groups_hold_every_preset_once_the_neutral_apart_from_those_under_forces():
+    neutral, forced = groups(2)
+    assert sorted(neutral + forced) == sorted(PRESETS)
+    assert not any(preset(name).forces for name in neutral)
+    assert all(preset(name).forces for name in forced)
+    assert groups(1) == [list(PRESETS)]
+
+
+@pytest.mark.slow
+def test_a_run_after_precompiling_its_preset_compiles_nothing(tmp_path):
+    environment = os.environ | {"NUMBA_CACHE_DIR": str(tmp_path)}
+    subprocess.run([sys.executable, "-m", "collidium.precompile", "head-on"],
+                   env=environment, check=True, timeout=600)  # fmt: skip
+    # the preset's own length: 1000 steps, flown between the summary's readings
+    run = subprocess.run([sys.executable, "-c", COUNT_COMPILED, "run", "head-on", "-q"],
+                         env=environment, capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split()[-2:] == ["COMPILED", "0"]
