@@ -73,7 +73,10 @@ def _precompile(package: Path, build_data: dict[str, Any]) -> Path | None:
     copy = folder / "collidium"
     shutil.copytree(package, copy, ignore=shutil.ignore_patterns("__pycache__"))
     environment = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
-    environment["PYTHONPATH"] = str(folder)  # the copy, whose own __pycache__ numba fills
+    # The copy first, whose own __pycache__ numba fills; then pip's isolated build environment,
+    # which it puts on the path the same way.
+    paths = [str(folder), *filter(None, environment.get("PYTHONPATH", "").split(os.pathsep))]
+    environment["PYTHONPATH"] = os.pathsep.join(paths)
     result = subprocess.run(
         [sys.executable, "-m", "collidium.precompile"],
         cwd=folder, env=environment, capture_output=True, text=True,

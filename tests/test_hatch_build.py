@@ -18,11 +18,14 @@ def _hook_module() -> Any:
 
 
 #: A stand-in for ``collidium.precompile``: writes what numba would, where numba would (the
-#: package's own __pycache__ folders), unless NUMBA_CACHE_DIR would send them elsewhere.
+#: package's own __pycache__ folders), unless NUMBA_CACHE_DIR would send them elsewhere or the
+#: build environment's packages (pip puts them on PYTHONPATH) are out of reach.
 FAKE_PRECOMPILE = """
 import os, pathlib, sys
 if "NUMBA_CACHE_DIR" in os.environ:
     sys.exit("NUMBA_CACHE_DIR is set")
+if "/pip-build-env/site" not in os.environ["PYTHONPATH"].split(os.pathsep):
+    sys.exit("the build environment is off the path")
 here = pathlib.Path(__file__).parent
 for folder in (here / "__pycache__", here / "kernels" / "__pycache__"):
     folder.mkdir(exist_ok=True)
@@ -44,6 +47,7 @@ def _package(tmp_path: Path, precompile: str) -> Path:
 
 def test_the_wheel_gets_the_cache_the_precompile_writes_into_a_copy(tmp_path, monkeypatch):
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "elsewhere"))
+    monkeypatch.setenv("PYTHONPATH", "/pip-build-env/site")
     monkeypatch.delenv("COLLIDIUM_PRECOMPILE", raising=False)
     package = _package(tmp_path, FAKE_PRECOMPILE)
     build_data: dict[str, Any] = {"force_include": {}}
