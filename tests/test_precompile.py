@@ -8,8 +8,10 @@ import sys
 
 import pytest
 
-from collidium.precompile import groups
+from collidium.kernels.audit import PARALLEL_FROM
+from collidium.precompile import _LARGE_GAS_PARAMETERS, LARGE_GAS, groups
 from collidium.presets import PRESETS, preset
+from collidium.runner import prepare
 
 #: Runs the command line in-process, then says how many kernels numba compiled (not loaded).
 COUNT_COMPILED = """
@@ -25,10 +27,16 @@ sys.exit(code)
 
 def test_two_groups_hold_every_preset_once_the_neutral_apart_from_those_under_forces():
     neutral, forced = groups(2)
-    assert sorted(neutral + forced) == sorted(PRESETS)
-    assert not any(preset(name).forces for name in neutral)
+    assert sorted(neutral + forced) == sorted([*PRESETS, LARGE_GAS])
+    assert LARGE_GAS in neutral
+    assert not any(preset(name).forces for name in neutral if name != LARGE_GAS)
     assert all(preset(name).forces for name in forced)
-    assert groups(1) == [list(PRESETS)]
+    assert groups(1) == [[*PRESETS, LARGE_GAS]]
+
+
+def test_the_large_gas_has_its_passes_run_in_parallel():
+    sim, _ = prepare(preset("gas", **_LARGE_GAS_PARAMETERS))
+    assert sim.particles.n >= PARALLEL_FROM
 
 
 @pytest.mark.slow

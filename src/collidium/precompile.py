@@ -18,23 +18,28 @@ from collidium.runner import execute, prepare
 
 #: Steps each preset runs: enough for the compiled flights between the summary's readings.
 STEPS = 20
+#: The gas with so many disks that the passes over all of them run in parallel chunks, kernels
+#: of their own (from `collidium.kernels.audit.PARALLEL_FROM`): as the viewer's large gases.
+LARGE_GAS = "large-gas"
+_LARGE_GAS_PARAMETERS = {"n": 20_000, "width": 350.0, "height": 350.0}
 
 
 def precompile(names: list[str], steps: int = STEPS) -> None:
-    """Run each preset in ``names`` for ``steps`` steps, as ``collidium run`` does, so that numba
-    compiles and caches every kernel they call."""
+    """Run each preset in ``names`` (or `LARGE_GAS`) for ``steps`` steps, as ``collidium run``
+    does, so that numba compiles and caches every kernel they call."""
     for name in names:
-        sim, job = prepare(preset(name), steps=steps)
+        spec = preset("gas", **_LARGE_GAS_PARAMETERS) if name == LARGE_GAS else preset(name)
+        sim, job = prepare(spec, steps=steps)
         execute(sim, job)
 
 
 def groups(workers: int) -> list[list[str]]:
-    """The presets in ``workers`` groups (at most two: the neutral ones, whose kernels are the
-    exact engine's, and those under forces), to compile side by side."""
+    """Every preset and `LARGE_GAS` in ``workers`` groups (at most two: the neutral ones, whose
+    kernels are the exact engine's, and those under forces), to compile side by side."""
+    forced = {name: bool(preset(name).forces) for name in PRESETS} | {LARGE_GAS: False}
     if workers < 2:
-        return [list(PRESETS)]
-    forced = {name: bool(preset(name).forces) for name in PRESETS}
-    return [[name for name in PRESETS if forced[name] == group] for group in (False, True)]
+        return [list(forced)]
+    return [[name for name in forced if forced[name] == group] for group in (False, True)]
 
 
 def main(argv: list[str] | None = None) -> int:

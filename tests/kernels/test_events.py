@@ -289,9 +289,66 @@ def test_engine_matches_twin_across_cell_crossings(rng):
 
 @pytest.mark.parametrize(
     "kernel",
-    [events.rebuild, events.run_events, events.synchronise, events.matches, audit._in_chunks],
+    [
+        events.rebuild,
+        events.run_events,
+        events.synchronise,
+        events.synchronise_in_chunks,
+        events.matches,
+        events.matches_in_chunks,
+        audit._in_chunks,
+    ],
 )
 def test_the_engine_lets_other_threads_run_while_it_works(kernel):
     """The viewer's server reads and sends while a step of a large gas runs in its worker thread
     (ARCHITECTURE.md, "The viewer's frames"): the step's kernels release Python's lock."""
     assert kernel.targetoptions.get("nogil") is True
+
+
+def _large_gas(rng, n: int) -> Simulation:
+    """n disks of radius 0.25 m at packing 0.1 in a square box, speeds about 10 m/s."""
+    side = float(np.sqrt(n * np.pi * 0.25**2 / 0.1))
+    position = jittered_lattice(int(np.ceil(np.sqrt(n))), side - 1.0, 0.25, rng)[:n]
+    velocity = rng.normal(0.0, 7.0, (n, 2))
+    return Simulation(Box(side, side), Particles(position, velocity, radius=0.25), dt=0.01)
+
+
+def test_the_parallel_passes_write_and_check_what_the_serial_ones_do(rng):
+    """`synchronise_in_chunks` writes the same bits and strays as `synchronise`, and
+    `matches_in_chunks` answers as `matches`, also to a change in the first or the last chunk."""
+    sim = _large_gas(rng, 5 * 4096 + 77)  # five chunks, the last one longer
+    sim.run(steps=2)
+    s, p = sim._drift._state, sim.particles
+    later = sim.time + 0.004  # between events: every particle is moved on from its own time
+    written = []
+    for synchronise in (events.synchronise, events.synchronise_in_chunks):
+        position, velocity = np.full_like(p.position, np.nan), np.full_like(p.velocity, np.nan)
+        strays = synchronise(later, s["body"], s["event"], s["geometry"], s["grid"], position,
+                             velocity)  # fmt: skip
+        written.append((position.tobytes(), velocity.tobytes(), strays))
+    assert written[0] == written[1]
+    assert not np.isnan(np.frombuffer(written[0][0])).any()
+    arguments = (sim.time, s["body"], s["event"], s["geometry"])
+    for index in (int(s["event"][0, events.IDENT]), int(s["event"][-1, events.IDENT]), None):
+        if index is not None:
+            p.velocity[index, 1] = np.nextafter(p.velocity[index, 1], np.inf)
+        answers = {bool(matches(*arguments, p.position, p.velocity, p.radius, p.mass))
+                   for matches in (events.matches, events.matches_in_chunks)}  # fmt: skip
+        assert answers == {index is None}
+        if index is not None:
+            p.velocity[index, 1] = np.nextafter(p.velocity[index, 1], -np.inf)
+
+
+def test_a_large_gas_runs_the_same_bits_with_its_passes_in_parallel_or_not(rng, monkeypatch):
+    """From `audit.PARALLEL_FROM` particles the engine writes and checks the particles in
+    parallel chunks (`collisions._many`); a run is bit for bit the one made serially."""
+    runs, n = [], audit.PARALLEL_FROM + 1000
+    for threshold in (audit.PARALLEL_FROM, 10**9):
+        monkeypatch.setattr(audit, "PARALLEL_FROM", threshold)
+        sim = _large_gas(np.random.default_rng(5), n)
+        sim.run(steps=10)
+        p = sim.particles
+        runs.append((p.position.tobytes(), p.velocity.tobytes(), sim.counters.pair_collisions,
+                     sim._drift.rebuilds))  # fmt: skip
+    assert runs[0] == runs[1]
+    assert runs[0][2] > 1000 and runs[0][3] == 1  # one queue, kept from step to step

@@ -46,12 +46,14 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from collidium.kernels import parabolas, wall_responses
 from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import bounce_factor, energy_change, pair_response
 from collidium.kernels.compilation import inlined, uncounted
+from collidium.kernels.stepper import chunk_count
 from collidium.kernels.vessels import BOX, contacts
 from collidium.kernels.vessels import piston as pistons
 
@@ -1012,11 +1014,31 @@ def synchronise(now, body, event, geometry, grid, position, velocity) -> int:
     ``velocity`` (N, 2), by particle; the lazily kept state is untouched so the queue stays
     valid. Returns how many particles are outside the cells' window (they share its edge cells:
     right, but slow when they are many)."""
+    return _synchronise_between(0, body.shape[0], now, body, event, geometry, grid, position,
+                                velocity)  # fmt: skip
+
+
+@numba.njit(cache=True, parallel=True, nogil=True)
+def synchronise_in_chunks(now, body, event, geometry, grid, position, velocity) -> int:
+    """`synchronise` in parallel chunks of slots, for many particles (`audit.PARALLEL_FROM`): each
+    particle is written once, so any number of threads writes the same."""
+    n = body.shape[0]
+    chunks = chunk_count(n)
+    strays = np.zeros(chunks, dtype=np.int64)
+    for p in numba.prange(chunks):
+        strays[p] = _synchronise_between(p * n // chunks, (p + 1) * n // chunks, now, body,
+                                         event, geometry, grid, position, velocity)  # fmt: skip
+    return strays.sum()
+
+
+@inlined
+def _synchronise_between(start, stop, now, body, event, geometry, grid, position, velocity):
+    """`synchronise` for the slots ``start`` to ``stop - 1``: their strays."""
     x0, y0 = geometry[GRID_LEFT], geometry[GRID_BOTTOM]
     x1 = x0 + grid[0] * geometry[CELL_WIDTH]
     y1 = y0 + grid[1] * geometry[CELL_HEIGHT]
     strays = 0
-    for k in range(body.shape[0]):
+    for k in range(start, stop):
         i = event[k, IDENT]
         x, y, vx, vy = _at(k, now, body, geometry)
         position[i, 0] = x
@@ -1031,7 +1053,26 @@ def synchronise(now, body, event, geometry, grid, position, velocity) -> int:
 def matches(now, body, event, geometry, position, velocity, radius, mass) -> bool:
     """True if the particles are exactly what `synchronise` wrote at ``now`` (s), with the
     engine's radii and masses: nobody changed them since, and the queue is still valid."""
-    for k in range(body.shape[0]):
+    return _matches_between(0, body.shape[0], now, body, event, geometry, position, velocity,
+                            radius, mass)  # fmt: skip
+
+
+@numba.njit(cache=True, parallel=True, nogil=True)
+def matches_in_chunks(now, body, event, geometry, position, velocity, radius, mass) -> bool:
+    """`matches` in parallel chunks of slots, for many particles (`audit.PARALLEL_FROM`)."""
+    n = body.shape[0]
+    chunks = chunk_count(n)
+    same = np.zeros(chunks, dtype=np.bool_)
+    for p in numba.prange(chunks):
+        same[p] = _matches_between(p * n // chunks, (p + 1) * n // chunks, now, body, event,
+                                   geometry, position, velocity, radius, mass)  # fmt: skip
+    return bool(same.all())
+
+
+@inlined
+def _matches_between(start, stop, now, body, event, geometry, position, velocity, radius, mass):
+    """`matches` for the slots ``start`` to ``stop - 1``."""
+    for k in range(start, stop):
         i = event[k, IDENT]
         x, y, vx, vy = _at(k, now, body, geometry)
         if (
