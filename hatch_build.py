@@ -13,16 +13,18 @@ run (``python -m collidium.precompile``, run on a copy of the package in the bui
 environment, which holds collidium's dependencies for it), so that the first run after ``pip
 install .`` loads them instead of compiling them. numba keys its cache by the source's content,
 its own version and the CPU, so a wheel used elsewhere, or with another numba, compiles on its
-first run as without it. ``COLLIDIUM_PRECOMPILE=0`` builds without it (a wheel to publish).
+first run as without it. The compiled copy stays in ``build/kernels/`` for the next build from
+the same sources. ``COLLIDIUM_PRECOMPILE=0`` builds without it (a wheel to publish).
 """
 
 from __future__ import annotations
 
+import hashlib
+import importlib.metadata
 import os
 import shutil
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -38,13 +40,9 @@ class BuildHook(BuildHookInterface):  # type: ignore[type-arg]
 
     def initialize(self, version: str, build_data: dict[str, Any]) -> None:
         self._bundle_front_end(build_data)
-        self._compiled: Path | None = None
         if self.target_name == "wheel" and version == "standard":
-            self._compiled = _precompile(Path(self.root) / "src" / "collidium", build_data)
-
-    def finalize(self, version: str, build_data: dict[str, Any], artifact_path: str) -> None:
-        if getattr(self, "_compiled", None) is not None:
-            shutil.rmtree(self._compiled, ignore_errors=True)
+            root = Path(self.root)
+            _precompile(root / "src" / "collidium", root / "build" / "kernels", build_data)
 
     def _bundle_front_end(self, build_data: dict[str, Any]) -> None:
         """Runs ``npm ci`` and ``npm run build`` in ``frontend/`` where the bundles are stale."""
@@ -62,32 +60,53 @@ class BuildHook(BuildHookInterface):  # type: ignore[type-arg]
         build_data["artifacts"] += [str(path.relative_to(root)) for path in outputs]
 
 
-def _precompile(package: Path, build_data: dict[str, Any]) -> Path | None:
-    """Compile the presets' kernels on a copy of ``package`` and add numba's cache files to the
-    wheel (``force_include``); returns the copy's folder, to remove once the wheel is written.
-    A failure leaves the wheel without them (its first run compiles), with a line saying why."""
+def _precompile(package: Path, folder: Path, build_data: dict[str, Any]) -> None:
+    """Compile the presets' kernels on a copy of ``package`` in ``folder`` and add numba's cache
+    files to the wheel (``force_include``). The copy is kept, with a stamp of what it was
+    compiled from (`_sources_stamp`): a build from the same sources ships it again without
+    compiling (``pip install ".[test]"`` after ``pip install .``). A failure leaves the wheel
+    without them (its first run compiles), with a line saying why."""
     if os.environ.get("COLLIDIUM_PRECOMPILE") == "0":
         sys.stderr.write("collidium: COLLIDIUM_PRECOMPILE=0, building without compiled kernels\n")
-        return None
-    folder = Path(tempfile.mkdtemp(prefix="collidium-kernels-"))
-    copy = folder / "collidium"
-    shutil.copytree(package, copy, ignore=shutil.ignore_patterns("__pycache__"))
-    environment = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
-    # The copy first, whose own __pycache__ numba fills; then pip's isolated build environment,
-    # which it puts on the path the same way.
-    paths = [str(folder), *filter(None, environment.get("PYTHONPATH", "").split(os.pathsep))]
-    environment["PYTHONPATH"] = os.pathsep.join(paths)
-    result = subprocess.run(
-        [sys.executable, "-m", "collidium.precompile"],
-        cwd=folder, env=environment, capture_output=True, text=True,
-    )  # fmt: skip
-    if result.returncode != 0:
-        reason = (result.stderr.strip().splitlines() or ["no output"])[-1]
-        sys.stderr.write(f"collidium: building without compiled kernels: {reason}\n")
-        return folder
+        return
+    copy, stamp_file = folder / "collidium", folder / "compiled-from"
+    stamp = _sources_stamp(package)
+    if not (stamp_file.is_file() and stamp_file.read_text() == stamp):
+        shutil.rmtree(folder, ignore_errors=True)
+        shutil.copytree(package, copy, ignore=shutil.ignore_patterns("__pycache__"))
+        environment = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+        # The copy first, whose own __pycache__ numba fills; then pip's isolated build
+        # environment, which it puts on the path the same way.
+        paths = [str(folder), *filter(None, environment.get("PYTHONPATH", "").split(os.pathsep))]
+        environment["PYTHONPATH"] = os.pathsep.join(paths)
+        result = subprocess.run(
+            [sys.executable, "-m", "collidium.precompile"],
+            cwd=folder, env=environment, capture_output=True, text=True,
+        )  # fmt: skip
+        if result.returncode != 0:
+            reason = (result.stderr.strip().splitlines() or ["no output"])[-1]
+            sys.stderr.write(f"collidium: building without compiled kernels: {reason}\n")
+            return
+        stamp_file.write_text(stamp)
     for path in sorted(copy.rglob("__pycache__/*.nb[ic]")):
         build_data["force_include"][str(path)] = f"collidium/{path.relative_to(copy).as_posix()}"
-    return folder
+
+
+def _sources_stamp(package: Path) -> str:
+    """A digest of every file of ``package`` (but caches), the Python running the build and the
+    versions of the compiler's packages: what numba's cache depends on, on this machine."""
+    digest = hashlib.sha256(sys.version.encode())
+    for name in ("numba", "llvmlite", "numpy"):
+        try:
+            version = importlib.metadata.version(name)
+        except importlib.metadata.PackageNotFoundError:  # the precompile will say so
+            version = "missing"
+        digest.update(f"{name} {version}".encode())
+    for path in sorted(package.rglob("*")):
+        if path.is_file() and "__pycache__" not in path.parts:
+            digest.update(path.relative_to(package).as_posix().encode())
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
 
 
 def _sources(frontend: Path) -> list[Path]:
