@@ -133,9 +133,7 @@ def answers_in_one_line(args: list[str], capsys: pytest.CaptureFixture[str]) -> 
     assert len(lines) == 1 and lines[0].startswith("error: "), err
 
 
-@settings(
-    max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
-)
+@settings(max_examples=60, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(edits)
 def test_random_scenario_files_get_one_line_or_run(tmp_path_factory, capsys, changes):
     import copy
@@ -158,9 +156,7 @@ setting_text = st.one_of(
 )
 
 
-@settings(
-    max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
-)
+@settings(max_examples=60, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(st.lists(st.sampled_from(KEYS), min_size=1, max_size=3).map(".".join), setting_text)
 def test_random_settings_get_one_line_or_run(capsys, key, text):
     answers_in_one_line(["run", "gas", "--set", "n=20", "--set", f"{key}={text}", "--steps", "1",
