@@ -39,6 +39,15 @@ def test_the_large_gas_has_its_passes_run_in_parallel():
     assert sim.particles.n >= PARALLEL_FROM
 
 
+def test_an_unknown_preset_gets_one_line_and_exit_2_before_anything_compiles():
+    run = subprocess.run([sys.executable, "-m", "collidium.precompile", "gas", "nosuch"],
+                         capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert run.returncode == 2
+    assert run.stdout == ""
+    assert run.stderr.startswith("collidium: preset: unknown preset 'nosuch'; choose from head-on")
+    assert run.stderr.count("\n") == 1
+
+
 @pytest.mark.slow
 def test_a_run_after_precompiling_its_preset_compiles_nothing(tmp_path):
     environment = os.environ | {"NUMBA_CACHE_DIR": str(tmp_path)}

@@ -46,6 +46,14 @@ def main(argv: list[str] | None = None) -> int:
     """Precompile the presets named (in this process), or every preset in a process per group
     (`groups`), saying how long it took."""
     names = sys.argv[1:] if argv is None else argv
+    if {"-h", "--help"} & set(names):
+        sys.stdout.write(f"{__doc__}\nusage: python -m collidium.precompile [PRESET ...]\n")
+        return 0
+    known = [*PRESETS, LARGE_GAS]
+    if unknown := [name for name in names if name not in known]:
+        sys.stderr.write(f"collidium: preset: unknown preset {unknown[0]!r}; choose from "
+                         f"{', '.join(known)}\n")  # fmt: skip
+        return 2
     start = time.perf_counter()
     if names:
         precompile(names)
