@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -13,16 +14,8 @@ from collidium.precompile import _LARGE_GAS_PARAMETERS, LARGE_GAS, groups
 from collidium.presets import PRESETS, preset
 from collidium.runner import prepare
 
-#: Runs the command line in-process, then says how many kernels numba compiled (not loaded).
-COUNT_COMPILED = """
-import gc, sys
-import numba.core.registry
-from collidium.cli import main
-code = main(sys.argv[1:])
-print("COMPILED", sum(sum(d.stats.cache_misses.values()) for d in gc.get_objects()
-                      if isinstance(d, numba.core.registry.CPUDispatcher)))
-sys.exit(code)
-"""
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from bench_first_run import timed_run  # the benchmarks folder is not a package
 
 
 def test_two_groups_hold_every_preset_once_the_neutral_apart_from_those_under_forces():
@@ -50,11 +43,8 @@ def test_an_unknown_preset_gets_one_line_and_exit_2_before_anything_compiles():
 
 @pytest.mark.slow
 def test_a_run_after_precompiling_its_preset_compiles_nothing(tmp_path):
-    environment = os.environ | {"NUMBA_CACHE_DIR": str(tmp_path)}
     subprocess.run([sys.executable, "-m", "collidium.precompile", "head-on"],
-                   env=environment, check=True, timeout=600)  # fmt: skip
-    # the preset's own length: 1000 steps, flown between the summary's readings
-    run = subprocess.run([sys.executable, "-c", COUNT_COMPILED, "run", "head-on", "-q"],
-                         env=environment, capture_output=True, text=True, timeout=600)  # fmt: skip
-    assert run.returncode == 0, run.stderr
-    assert run.stdout.split()[-2:] == ["COMPILED", "0"]
+                   env=os.environ | {"NUMBA_CACHE_DIR": str(tmp_path)},
+                   check=True, timeout=600)  # fmt: skip
+    # F1's run: 100 steps, flown between the summary's readings, counting what numba compiled
+    assert timed_run("head-on", str(tmp_path))["compiled"] == 0

@@ -735,9 +735,10 @@ class ExactCollisions:
         """Whether `fly` may take steps now: the queue is built for this ``fall``, nobody
         changed the particles since it wrote them, and the particles are fewer than
         `collidium.kernels.audit.PARALLEL_FROM` (`Drift.flies`). With more, a step takes
-        milliseconds, its Python is nothing beside them, and the run loop's audit runs on every
-        core where the flight's would run on one (a 1e5-disk gas's step took 7-10% longer
-        flown)."""
+        milliseconds, its Python is nothing beside them, and the run loop's audit and the
+        engine's passes over every particle run on every core where the flight's would run on
+        one (a 1e5-disk gas's step took 7-10% longer flown, before those passes were
+        parallel)."""
         return not _many(particles) and self._is_current(particles, tally.piston, fall)
 
     def fly(

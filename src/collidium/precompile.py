@@ -54,10 +54,10 @@ def main(argv: list[str] | None = None) -> int:
         sys.stderr.write(f"collidium: preset: unknown preset {unknown[0]!r}; choose from "
                          f"{', '.join(known)}\n")  # fmt: skip
         return 2
-    start = time.perf_counter()
     if names:
         precompile(names)
         return 0
+    start = time.perf_counter()
     command = [sys.executable, "-m", "collidium.precompile"]
     workers = [subprocess.Popen(command + group) for group in groups(os.cpu_count() or 1)]
     failed = [worker.args for worker in workers if worker.wait() != 0]
