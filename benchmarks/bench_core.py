@@ -11,6 +11,9 @@ W2  charged gas (all cores): microseconds per particle-step of the Coulomb sum, 
     N = 200 .. 1e6, with the tree's RMS relative force error; direct pair interactions per second,
     of a kick's sum (forces alone) and of one with the energies; REBOUND direct ("basic") and tree
     gravity at equal N.
+W4  the charged-gas preset scaled to N = 1e4 .. 1e5 at its density, tree sum and exact collisions
+    (all cores): microseconds per particle-step at its dt = 0.01 s, with the fixed and the
+    adaptive integrator, and the queues built per step (one per substep).
 W3  the seed report's scenes (every preset): wall seconds per simulated second, quiet and beside
     one CPU-bound process per core (started and stopped here), and the ratio of the speeds.
 M   peak resident memory of an exact run at N = 1e6, and per particle.
@@ -36,6 +39,7 @@ from collidium.forces import TREE_CROSSOVER
 from collidium.initial import random_positions
 from collidium.kernels import reference, tree
 from collidium.kernels.pairwise import inverse_distance_direct
+from collidium.observers import EnergyDrift
 from collidium.presets import PRESETS, preset
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -165,6 +169,39 @@ def coulomb_costs(n: int, with_direct: bool, error_targets: int) -> dict[str, An
     exact = reference.inverse_distance_on(position, charge, 5.0, 0.0, targets)
     error = np.linalg.norm(force[targets] - exact, axis=1) / np.linalg.norm(exact, axis=1)
     out["tree_rms_relative_error"] = float(np.sqrt(np.mean(error**2)))
+    return out
+
+
+def charged_exact_costs(n: int, steps: int) -> list[dict[str, Any]]:
+    """W4: the charged-gas preset with n disks in a box grown to keep its density, summed by
+    tree, exact collisions, all cores: wall microseconds per particle-step over ``steps`` steps
+    of dt = 0.01 s after a warm-up step, for each integrator; the drifts (queues built) per step
+    and the largest relative energy drift, as `collidium run` measures it."""
+    side = 20.0 * math.sqrt(n / 200)
+    out = []
+    for integrator in ("fixed", "adaptive"):
+        sim = cd.load(
+            "charged-gas",
+            n=n,
+            **{"vessel.width": side, "vessel.height": side, "forces.0.method": "tree",
+               "run.integrator": integrator},
+        )  # fmt: skip
+        drift = EnergyDrift()  # as `collidium run` measures it, every step
+        sim.observers.append(drift)
+        sim.run(steps=1)
+        built, start = sim._drift.rebuilds, time.perf_counter()
+        sim.run(steps=steps)
+        seconds = time.perf_counter() - start
+        out.append(
+            {
+                "n": n,
+                "integrator": integrator,
+                "threads": numba.get_num_threads(),
+                "us_per_particle_step": seconds / (steps * n) * 1e6,
+                "queues_per_step": (sim._drift.rebuilds - built) / steps,
+                "max_rel_drift": drift.max_rel_drift,
+            }
+        )
     return out
 
 
@@ -356,6 +393,20 @@ def main() -> None:
                 "REBOUND tree",
                 ours,
                 theirs,
+            )
+        )
+
+    w4_sizes = [10_000] if quick else [10_000, 100_000]
+    w4 = [row for n in w4_sizes for row in charged_exact_costs(n, 5 if n > 10_000 else 20)]
+    out["w4_charged_exact"] = w4
+    for row in w4:
+        rows.append(
+            (
+                f"W4 charged gas N={row['n']:,} {row['integrator']} ({row['threads']} thr)",
+                f"{row['us_per_particle_step']:.3g} us/p-step, "
+                f"{row['queues_per_step']:.3g} queues/step",
+                "",
+                f"drift {row['max_rel_drift']:.1e}",
             )
         )
 

@@ -629,7 +629,8 @@ class ExactCollisions:
             if piston.size
             else np.empty(0)
         )
-        events.rebuild(now, *_queue(s, vessel))
+        rebuild = events.rebuild_in_chunks if _many(particles) else events.rebuild
+        rebuild(now, *_queue(s, vessel))
         return s
 
     def _layout(
@@ -874,6 +875,7 @@ def _engine_arrays(n: int, cells: int, columns: int = events.BODY_COLUMNS) -> di
     index = np.int32
     rows = _cache_aligned_rows(n, events.SLOT_COLUMNS, index)
     views = {name: rows[:, column] for name, column in _SLOT_VIEWS.items()}
+    views["ident"][...] = np.arange(n)  # slot k holds particle k until the first sort
     return {
         "body": _cache_aligned_rows(n, columns),
         "head": np.empty(cells, dtype=index),

@@ -623,28 +623,67 @@ def sort_slots(body, cell_of, event, head, next_, items, where) -> None:
 def rebuild(now, body, geometry, grid, head, next_, event, keys, items, segments, piston) -> None:
     """Start a fresh queue at time ``now`` (s) from positions synchronised at ``now``.
 
-    ``body``'s positions, velocities, radii and masses and the slots' particles are filled by
-    the caller (see `load`); this sets the stamps, sorts the slots by cell and predicts every
-    event.
+    ``body``'s positions, velocities, radii and masses are filled by the caller (see `load`);
+    this sets the stamps, sorts the slots by cell and predicts every event.
     """
-    ident, cell_of, count, where = _slot_views(event)
     n = body.shape[0]
+    _restart_between(0, n, now, body, geometry, grid, event, items)
+    _sort_restarted(body, event, head, next_, items)
+    _predict_between(0, n, now, body, geometry, grid, head, next_, event, keys, segments, piston)
+    _heap_build(keys, items, event[:, WHERE])
+
+
+@numba.njit(cache=True, parallel=True, nogil=True)
+def rebuild_in_chunks(
+    now, body, geometry, grid, head, next_, event, keys, items, segments, piston
+) -> None:
+    """`rebuild` with its passes over every slot in parallel chunks, for many particles
+    (`audit.PARALLEL_FROM`): under forces the queue is built again at every substep. Each
+    slot's prediction is its own, so any number of threads builds the same queue."""
+    n = body.shape[0]
+    chunks = chunk_count(n)
+    for p in numba.prange(chunks):
+        _restart_between(p * n // chunks, (p + 1) * n // chunks, now, body, geometry, grid,
+                         event, items)  # fmt: skip
+    _sort_restarted(body, event, head, next_, items)
+    for p in numba.prange(chunks):
+        _predict_between(p * n // chunks, (p + 1) * n // chunks, now, body, geometry, grid, head,
+                         next_, event, keys, segments, piston)  # fmt: skip
+    _heap_build(keys, items, event[:, WHERE])
+
+
+@inlined
+def _restart_between(start, stop, now, body, geometry, grid, event, items) -> None:
+    """Stamp the slots ``start`` to ``stop - 1`` at ``now`` (s), find their cells and forget their
+    events and collision counts (``items`` gets each slot, for `sort_slots` to renumber)."""
     ncx = grid[0]
-    for k in range(n):
+    for k in range(start, stop):
         body[k, STAMP] = now
-        cell_of[k] = cell_index(
+        event[k, CELL] = cell_index(
             body[k, X], geometry[GRID_LEFT], geometry[CELL_WIDTH], ncx
         ) + ncx * cell_index(body[k, Y], geometry[GRID_BOTTOM], geometry[CELL_HEIGHT], grid[1])
-        count[k] = 0
+        event[k, COUNT] = 0
         event[k, CODE] = NO_EVENT
         event[k, KEPT] = -1
         event[k, PARTNER_COUNT] = 0
         items[k] = k
-    sort_slots(body, cell_of, event, head, next_, items, where)
-    for k in range(n):
+
+
+@inlined
+def _sort_restarted(body, event, head, next_, items) -> None:
+    """`sort_slots` after `_restart_between`. The slots keep the order of the queue before
+    (`load`), sorted by the cells of a little earlier, so few rows move."""
+    sort_slots(body, event[:, CELL], event, head, next_, items, event[:, WHERE])
+
+
+@inlined
+def _predict_between(start, stop, now, body, geometry, grid, head, next_, event, keys, segments,
+                     piston) -> None:  # fmt: skip
+    """Predict the events of the slots ``start`` to ``stop - 1`` into ``event`` and ``keys``."""
+    ident, cell_of, count = event[:, IDENT], event[:, CELL], event[:, COUNT]
+    for k in range(start, stop):
         keys[k] = _predict_not_inlined(k, now, body, ident, geometry, grid, cell_of, head, next_,
                                        count, event, segments, piston)  # fmt: skip
-    _heap_build(keys, items, where)
 
 
 # --- the drift ----------------------------------------------------------------------------------
@@ -987,8 +1026,12 @@ def _wall_response(outward, pull, lead, forced):
 
 @uncounted()
 def load(position, velocity, radius, mass, body, event) -> None:
-    """Fill ``body`` (N, 7), or (N, 5) without radius and mass, and the slots' particles
-    (``event[:, IDENT]``) from the particles, in particle order.
+    """Fill ``body`` (N, 7), or (N, 5) without radius and mass, from the particles: slot k from
+    particle ``event[k, IDENT]``.
+
+    The slots keep their particles from queue to queue (a fresh engine's slot k holds particle
+    k): under forces the queue is built again at every substep, and the slots are then still
+    nearly in cell order (`rebuild`).
 
     Parameters
     ----------
@@ -997,15 +1040,15 @@ def load(position, velocity, radius, mass, body, event) -> None:
     radius, mass : ndarray, shape (N,)
         In m and kg.
     """
-    for i in range(position.shape[0]):
-        body[i, X] = position[i, 0]
-        body[i, Y] = position[i, 1]
-        body[i, VX] = velocity[i, 0]
-        body[i, VY] = velocity[i, 1]
+    for k in range(position.shape[0]):
+        i = event[k, IDENT]
+        body[k, X] = position[i, 0]
+        body[k, Y] = position[i, 1]
+        body[k, VX] = velocity[i, 0]
+        body[k, VY] = velocity[i, 1]
         if body.shape[1] > MASS:
-            body[i, RADIUS] = radius[i]
-            body[i, MASS] = mass[i]
-        event[i, IDENT] = i
+            body[k, RADIUS] = radius[i]
+            body[k, MASS] = mass[i]
 
 
 @uncounted(nogil=True)
