@@ -12,6 +12,7 @@ import pytest
 import collidium as cd
 from collidium import integrators
 from collidium.errors import InputError, SimulationError
+from collidium.forces.base import ForceField
 from collidium.integrators import DEFAULT_TOLERANCE
 from collidium.kernels import kick_timing, substeps
 from collidium.kernels.pairwise import PARALLEL_DIRECT_FROM as PARALLEL_ROWS
@@ -189,8 +190,39 @@ def test_an_unwatched_fixed_step_sums_no_energies(monkeypatch):
     sim = cd.load("charged-like", integrator="fixed")
     sim.observers.append(cd.observers.EnergyDrift())
     sim.run(steps=30)
-    # The first sample's evaluation, the run's first (forces alone), one a step with energies.
-    assert asked == [True, False] + [True] * 30
+    # The first sample's evaluation, the run's first (with the energies: they were read), one a
+    # step with energies.
+    assert asked == [True] * 32
+    asked.clear()
+    sim.run(steps=3)  # the energies were read after the last step: summed at the run's start
+    assert asked == [True] * 4
+
+
+def test_a_step_evaluates_the_forces_once_a_substep_also_when_taken_again(monkeypatch):
+    """Run one step at a time, watched every step, an interval evaluates the forces once at the
+    run's start and once a substep: its read of the energies and those of the observer take
+    them from the evaluations, and an interval taken again with more substeps starts from the
+    forces it began with, evaluated no second time."""
+    sim = cd.load("charged-opposite", **{"forces.0.method": "tree"})  # substeps in Python
+    sim.observers.append(cd.observers.EnergyDrift())
+    sim.run(steps=1)
+    compute, calls = cd.Coulomb.compute, []
+    monkeypatch.setattr(cd.Coulomb, "compute", lambda self, *args: calls.append(args[-1])
+                        or compute(self, *args))  # fmt: skip
+    restore, retries = ForceField.restore, []
+    monkeypatch.setattr(ForceField, "restore", lambda self, saved: retries.append(1)
+                        or restore(self, saved))  # fmt: skip
+    for _ in range(100):  # an interval is taken again about once in 100 steps
+        calls.clear()
+        drifts, taken_again = sim._drift.rebuilds, len(retries)
+        sim.run(steps=1)
+        substeps = sim._drift.rebuilds - drifts  # one queue a drift, the abandoned ones too
+        tries = 1 + len(retries) - taken_again
+        # One evaluation at the run's start and one a drift; the energies with the first and
+        # with each try's last.
+        assert len(calls) == 1 + substeps
+        assert calls[0] and calls[-1] and calls.count(True) == 1 + tries
+    assert retries  # some interval was taken again
 
 
 def test_integrator_and_tolerance_can_change_between_runs():

@@ -318,6 +318,7 @@ class AdaptiveLeapfrog(Integrator):
         total = sums.kinetic_energy(particles.mass, particles.velocity) + field.potential(
             particles, vessel
         )
+        evaluated = field.saved()  # put back with the particles: no evaluation to take it again
         rate2 = (
             _squared_rate(particles, vessel, field, total)
             if flight is None
@@ -336,13 +337,13 @@ class AdaptiveLeapfrog(Integrator):
                 )
             except SimulationError:  # any stop inside the interval leaves the state it began from
                 start.restore(particles, tally)
-                field.evaluate(particles, vessel)
+                field.restore(evaluated)
                 raise
             required = self.needed(fastest, dt)
             if required <= n:
                 break
             start.restore(particles, tally)
-            field.evaluate(particles, vessel)
+            field.restore(evaluated)
             n = max(required, 2 * n)
         self.substeps = max(1, n // 2) if required <= n // 2 else n
 

@@ -395,7 +395,7 @@ class Simulation:
                 observer.attach(self)
                 self._attached.append(observer)
         if self._field.kicks:
-            self._field.evaluate(self.particles, self.container)
+            self._field.refresh(self.particles, self.container)
         if progress:
             from rich.console import Console
             from rich.progress import Progress

@@ -348,6 +348,20 @@ def _refuse_infinite(acceleration: FloatArray) -> None:
         )
 
 
+@dataclasses.dataclass(frozen=True, eq=False)
+class Evaluation:
+    """What a `ForceField` evaluation left (`ForceField.saved`): the accelerations (N, 2) in
+    m/s^2, the potential and the pair virial in J if ``with_energies``, the positions (N, 2) in m
+    it was made at, and whether the energies were read since the last step's end."""
+
+    acceleration: FloatArray
+    potential: float
+    virial: float
+    with_energies: bool
+    at: FloatArray | None
+    read: bool
+
+
 class ForceField:
     """All forces of a simulation: total acceleration and potential energy of the position
     forces, with reused buffers, and the flow of the velocity forces.
@@ -442,6 +456,13 @@ class ForceField:
             self._read = False
         return self._evaluate(particles, vessel, energies)
 
+    def refresh(self, particles: Particles, vessel: Vessel) -> FloatArray:
+        """`evaluate` for a run's start: the particles may have changed since the last run. The
+        energies are summed too if those of the last step were read, as they will likely be
+        again: a run of one step at a time (the viewer's ticks) then pays no second evaluation
+        for them."""
+        return self._evaluate(particles, vessel, self._read)
+
     def _evaluate(self, particles: Particles, vessel: Vessel, energies: bool) -> FloatArray:
         n = particles.n
         if self._force.shape[0] != n:
@@ -468,6 +489,24 @@ class ForceField:
         self._with_energies = energies
         self._evaluated_at = particles.position.copy()
         return self._acceleration
+
+    def saved(self) -> Evaluation:
+        """The last evaluation, for `restore` to put back when the particles are put back where
+        it was made (an interval taken again) instead of evaluating the same forces again."""
+        at = self._evaluated_at
+        return Evaluation(
+            self._acceleration.copy(), self._potential, self._virial_sum, self._with_energies,
+            None if at is None else at.copy(), self._read,
+        )  # fmt: skip
+
+    def restore(self, saved: Evaluation) -> None:
+        """Make ``saved`` (from `saved`, with the particles as many) the last evaluation again."""
+        self._acceleration[...] = saved.acceleration
+        self._potential = saved.potential
+        self._virial_sum = saved.virial
+        self._with_energies = saved.with_energies
+        self._evaluated_at = saved.at
+        self._read = saved.read
 
     def compiled(self, particles: Particles, vessel: Vessel) -> CompiledForces | None:
         """The forces as the compiled substeps take them (`collidium.kernels.substeps`), or
