@@ -647,3 +647,44 @@ def test_small_scenes_fly_between_the_observers_that_read_the_state(monkeypatch)
     assert calls == []
     shown = cd.load("orbit").run(steps=2 * simulation.MOST_FLOWN + 10, progress=True)
     np.testing.assert_array_equal(shown.particles.position, alone.particles.position)
+
+
+class Reverser:
+    """Observer: turns back the first particle every third step (a user's observer may write)."""
+
+    def __init__(self) -> None:
+        self.trigger = Every(3)
+
+    def attach(self, sim: cd.Simulation) -> None:
+        pass
+
+    def update(self, sim: cd.Simulation) -> None:
+        sim.particles.velocity[0] *= -1.0
+
+
+@pytest.mark.parametrize("scene", ["gas", "charged-gas"])
+def test_steps_taken_one_by_one_skip_the_engine_check_only_where_nothing_else_ran(
+    scene, monkeypatch
+):
+    """Between two steps of one run that no observer followed but those that only read (those
+    with ``take_flown``, here the energy drift every step), nothing but the drift moved the
+    particles: the run loop vouches for them (`Drift.vouch`) and the engine skips its check.
+    Never under forces that kick, never after another observer, which may write (here one that
+    turns a disk back): the run is bit for bit the one that checks before every step."""
+    runs, vouched, vouch = [], [], ExactCollisions.vouch
+    for vouching in (True, False):
+        if vouching:
+            monkeypatch.setattr(ExactCollisions, "vouch", lambda self: vouched.append(1)
+                                or vouch(self))  # fmt: skip
+        else:
+            monkeypatch.setattr(ExactCollisions, "vouch", lambda self: None)
+        sim = cd.load(scene, n=60, seed=4)
+        sim.observers += [Reverser(), cd.observers.EnergyDrift()]
+        monkeypatch.setattr(sim, "_run_length", lambda left: 1)  # no flights: step by step
+        sim.run(steps=30)
+        p = sim.particles
+        runs.append((p.position.tobytes(), p.velocity.tobytes(), sim.counters.pair_collisions))
+    assert runs[0] == runs[1]
+    assert runs[0][2] > 0
+    # Every step but the first of the run and the 9 after the observer's firings at 3, ..., 27.
+    assert len(vouched) == (0 if scene == "charged-gas" else 30 - 1 - 9)

@@ -270,6 +270,11 @@ class Drift(Protocol):
         particle outside the vessel or a value not finite ends the flight, taken, for the run loop's
         audit to report."""
 
+    def vouch(self) -> None:
+        """Say that the particles are as this mode's last drift left them, and stay so up to
+        its next drift: that drift may skip checking them (the run loop knows it between two
+        steps that nothing else touched)."""
+
     def state(self) -> dict[str, np.ndarray]:
         """Arrays a checkpoint needs to continue bit for bit (empty if the mode keeps none)."""
 
@@ -354,6 +359,9 @@ class _Stateless:
 
     def forget(self) -> None:
         """Nothing kept."""
+
+    def vouch(self) -> None:
+        """Nothing checked (`Drift.vouch`)."""
 
     def flies(self, particles: Particles, tally: Tally, fall: FloatArray) -> bool:
         """Never: each step is its own call (`Drift.flies`)."""
@@ -556,6 +564,8 @@ class ExactCollisions:
         self._unlogged = ContactLog(0)
         #: Where a flight leaves the piston's face (`Tally.piston`'s two values).
         self._piston_now = np.zeros(2)
+        #: Whether the next drift may take the particles as the last one wrote them (`vouch`).
+        self._vouched = False
 
     def state(self) -> dict[str, np.ndarray]:
         """The event queue and lazily updated positions, and the event counters."""
@@ -591,7 +601,15 @@ class ExactCollisions:
         if self._state is not None:
             self._spare, self._state = self._state, None
 
-    def _is_current(self, particles: Particles, piston: FloatArray, fall: FloatArray) -> bool:
+    def vouch(self) -> None:
+        """Skip, at the next drift, the check that the particles are as the last one wrote them
+        (`Drift.vouch`): a pass over every particle in slot order, reading each at random, 1.2-1.4
+        ms at 1e5 disks on two cores."""
+        self._vouched = True
+
+    def _is_current(
+        self, particles: Particles, piston: FloatArray, fall: FloatArray, vouched: bool = False
+    ) -> bool:
         s = self._state
         if s is None or s["body"].shape[0] != particles.n:
             return False
@@ -599,6 +617,8 @@ class ExactCollisions:
             return False
         if not np.array_equal(_piston_now(s["piston"], self._synced_at), piston):
             return False
+        if vouched:
+            return True
         p = particles
         matches = events.matches_in_chunks if _many(p) else events.matches
         synced = matches(
@@ -698,7 +718,8 @@ class ExactCollisions:
         under forces (`Drift.drift`)."""
         fall = _NO_FALL if fall is None else fall
         _refuse_runaway(particles, vessel, dt, fall)
-        if not self._is_current(particles, tally.piston, fall):
+        vouched, self._vouched = self._vouched and self._synced_at == now, False
+        if not self._is_current(particles, tally.piston, fall, vouched):
             self._state = self._rebuild(particles, vessel, now, tally.piston, fall)
             self.rebuilds += 1
         s = self._state

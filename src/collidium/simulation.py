@@ -414,14 +414,18 @@ class Simulation:
         """Take ``count`` steps: one compiled call for each run of steps the integrator can fly
         (`Integrator.fly`) before an observer reads the state, the others one by one."""
         done = 0
+        untouched = False  # whether the particles are as the last step of this call left them
         while done < count:
             run = self._run_length(count - done)
             if run > 1:
                 flown = self._fly(run)
                 done += flown
+                untouched = False
                 if flown == run:
                     continue
-            self._step()
+            if untouched and not self._field.kicks:  # nothing but the drift moves them
+                self._drift.vouch()
+            untouched = not self._step()
             done += 1
 
     def _run_length(self, left: int) -> int:
@@ -532,7 +536,9 @@ class Simulation:
                 take = getattr(observer, "take_flown")  # noqa: B009 (not in the protocol)
                 take(self, flown)
 
-    def _step(self) -> None:
+    def _step(self) -> bool:
+        """One step, its audit and its observers; returns whether an observer fired that may
+        have changed the particles (one without ``take_flown``: those only read, `Observer`)."""
         try:
             self._integrator.step(
                 self.particles, self.container, self._field, self._drift, self.time, self.dt,
@@ -542,9 +548,12 @@ class Simulation:
             raise SimulationError(f"step {self.steps + 1} (t = {self.time:.6g} s): {exc}") from None
         self.steps += 1
         self._audit()
+        touched = False
         for observer in self.observers:
             if observer.trigger(self):
                 observer.update(self)
+                touched |= not hasattr(observer, "take_flown")
+        return touched
 
     def _audit(self) -> None:
         p = self.particles

@@ -188,7 +188,9 @@ class Observer(Protocol):
     An observer whose trigger is `foreseeable` and that reads no more than a `Flown` holds may
     also have ``take_flown(sim, flown)``: a run then flies the steps between the other
     observers' firings in one compiled call where it can and hands it what it would have read
-    at each of its own (`EnergyDrift`, `EnergySeries`, `Thermo`, `CollisionRate` do)."""
+    at each of its own (`EnergyDrift`, `EnergySeries`, `Thermo`, `CollisionRate` do). Such an
+    observer only reads: the run may fly past it, and takes the particles after its ``update``
+    to be as the step left them."""
 
     trigger: Trigger
 
