@@ -688,3 +688,17 @@ def test_steps_taken_one_by_one_skip_the_engine_check_only_where_nothing_else_ra
     assert runs[0][2] > 0
     # Every step but the first of the run and the 9 after the observer's firings at 3, ..., 27.
     assert len(vouched) == (0 if scene == "charged-gas" else 30 - 1 - 9)
+
+
+def test_a_drift_that_refuses_to_start_takes_the_vouch_with_it():
+    """A drift that refuses a runaway state consumes the run loop's vouch: the particles a user
+    then changes are checked at the next run, and the queue is built again for them."""
+    sim = cd.load("gas", n=60, seed=4).run(steps=2)
+    rebuilds, kept = sim._drift.rebuilds, sim.particles.velocity[0].copy()
+    sim._drift.vouch()
+    sim.particles.velocity[0] = 1e300
+    with pytest.raises(cd.SimulationError, match="run away"):
+        sim.run(steps=1)
+    sim.particles.velocity[0] = -kept
+    sim.run(steps=1)
+    assert sim._drift.rebuilds == rebuilds + 1

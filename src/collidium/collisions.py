@@ -716,9 +716,11 @@ class ExactCollisions:
     ) -> None:
         """Move ``particles`` from ``now`` to ``now + dt`` (s), in place, logging the contacts
         under forces (`Drift.drift`)."""
+        # Taken first: a drift that raises leaves no vouch for the particles a user may then
+        # change.
+        vouched, self._vouched = self._vouched and self._synced_at == now, False
         fall = _NO_FALL if fall is None else fall
         _refuse_runaway(particles, vessel, dt, fall)
-        vouched, self._vouched = self._vouched and self._synced_at == now, False
         if not self._is_current(particles, tally.piston, fall, vouched):
             self._state = self._rebuild(particles, vessel, now, tally.piston, fall)
             self.rebuilds += 1
