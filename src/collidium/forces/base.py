@@ -493,10 +493,11 @@ class ForceField:
     def saved(self) -> Evaluation:
         """The last evaluation, for `restore` to put back when the particles are put back where
         it was made (an interval taken again) instead of evaluating the same forces again."""
-        at = self._evaluated_at
+        # The accelerations are written in place by the next evaluation; the positions it was
+        # made at are a fresh array at each, so they are kept as they are.
         return Evaluation(
             self._acceleration.copy(), self._potential, self._virial_sum, self._with_energies,
-            None if at is None else at.copy(), self._read,
+            self._evaluated_at, self._read,
         )  # fmt: skip
 
     def restore(self, saved: Evaluation) -> None:
