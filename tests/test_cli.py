@@ -310,6 +310,24 @@ def test_a_first_compile_is_announced_once_at_a_terminal(monkeypatch, quiet):
     assert terminal.text == ("" if quiet else notice)
 
 
+def test_the_program_exits_with_the_status_of_main_and_its_objects_out_of_the_collector(
+    monkeypatch, capsys
+):
+    """`console` (the ``collidium`` program) returns what `main` does on ``sys.argv`` and leaves
+    the objects it made frozen, so that the interpreter's last collections pass them by."""
+    import gc
+
+    from collidium.cli import console
+
+    monkeypatch.setattr(sys, "argv", ["collidium", "run", "gas", "--set", "n=-1"])
+    try:
+        assert console() == 2
+        assert gc.get_freeze_count() > 0
+    finally:
+        gc.unfreeze()
+    assert capsys.readouterr().err == "error: n: must be >= 0, got -1\n"
+
+
 def test_failed_run_gives_one_line_and_exit_1(monkeypatch, capsys):
     import collidium.loading
     from collidium.cli import main

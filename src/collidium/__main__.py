@@ -2,7 +2,7 @@
 
 import sys
 
-from collidium.cli import main
+from collidium.cli import console
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(console())
