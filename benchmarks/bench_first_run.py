@@ -59,13 +59,14 @@ def timed_run(scene: str, cache: str | None, python: str = sys.executable) -> di
     with subprocess.Popen(command, env=environment, stdout=subprocess.DEVNULL,
                           stderr=subprocess.PIPE, text=True) as process:  # fmt: skip
         assert process.stderr is not None
-        lines, started = [], float("nan")
+        lines: list[str] = []
+        started = None
         for line in process.stderr:
-            if line.startswith("running ") and started != started:  # the first: NaN till then
+            if started is None and line.startswith("running "):
                 started = time.perf_counter() - start
             lines.append(line)
     wall = time.perf_counter() - start
-    if process.returncode != 0:
+    if process.returncode != 0 or started is None:
         raise RuntimeError("".join(lines))
     compiled = next(x for x in lines if x.startswith("COMPILED"))
     return {"wall_s": wall, "start_s": started, "compiled": int(compiled.split()[1])}
