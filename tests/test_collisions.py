@@ -8,7 +8,7 @@ import pytest
 
 import collidium as cd
 from collidium.collisions import ExactCollisions, Tally, _free_flight, make_drift
-from collidium.kernels import events
+from collidium.kernels import cells, events
 
 
 def _engine(sim: cd.Simulation) -> ExactCollisions:
@@ -99,6 +99,21 @@ def test_engine_rows_drop_radius_and_mass_only_while_all_disks_share_them():
     sim.run(steps=5)
     assert _engine(sim).rebuilds == 2
     assert _engine(sim)._state["body"].shape[1] == events.BODY_COLUMNS
+
+
+@pytest.mark.parametrize(
+    ("preset", "most"),
+    [("gas", cells.SMALL_SCENE_CELLS_PER_PARTICLE), ("atmosphere", cells.EVENT_CELLS_PER_PARTICLE),
+     ("effusion", cells.EVENT_CELLS_PER_PARTICLE)],
+)  # fmt: skip
+def test_engine_grid_takes_small_cells_in_a_small_scene_without_gravity_or_segments(preset, most):
+    """The engine lays out its grid by `cells.event_grid_shape`, told of the gravity it carries
+    (atmosphere) and of the vessel's segments (effusion's partition): more than 3 cells a disk
+    in the dilute gas, at most 3 in those two."""
+    sim = cd.load(preset).run(steps=2)
+    grid = _engine(sim)._state["grid"]
+    per_disk = grid[0] * grid[1] / sim.particles.n
+    assert cells.EVENT_CELLS_PER_PARTICLE * (most > 3) < per_disk <= most
 
 
 def test_engine_takes_84_bytes_per_disk_of_one_radius_and_mass_plus_4_per_cell():

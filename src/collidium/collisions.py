@@ -666,7 +666,9 @@ class ExactCollisions:
         diameter = 2.0 * float(particles.radius.max(initial=0.0))
         window = grid_window(particles.position, diameter, vessel.extent, vessel.periodic)
         width, height = window_sides(window)
-        ncx, ncy = event_grid_shape(width, height, diameter, n)
+        ncx, ncy = event_grid_shape(
+            width, height, diameter, n, falls=bool(np.any(fall)), segments=len(vessel.segments())
+        )
         shared = _shared_radius_and_mass(particles)
         columns = events.BODY_COLUMNS if shared is None else events.SHARED_BODY_COLUMNS
         if old is not None and old["body"].shape == (n, columns) and old["head"].size == ncx * ncy:

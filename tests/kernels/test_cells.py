@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -60,18 +61,22 @@ def test_a_vanishing_diameter_gets_the_fewest_cells_per_particle(diameter):
 
 def test_a_small_dilute_scene_takes_smaller_cells_than_a_large_one():
     """Below `SMALL_SCENE` particles a dilute gas's event grid has up to
-    `SMALL_SCENE_CELLS_PER_PARTICLE` cells a particle, from there on up to
-    `EVENT_CELLS_PER_PARTICLE`; neither makes a cell narrower than a diameter."""
+    `SMALL_SCENE_CELLS_PER_PARTICLE` cells a particle, from there on, under a gravity the engine
+    carries or with segments up to `EVENT_CELLS_PER_PARTICLE`; no cell is narrower than a
+    diameter."""
 
-    def cells_per_particle(n: int, area_per_particle: float) -> float:
+    def cells_per_particle(n: int, area_per_particle: float, **vessel: Any) -> float:
         side = math.sqrt(n * area_per_particle)
-        ncx, ncy = cells.event_grid_shape(side, side, 0.5, n)
+        ncx, ncy = cells.event_grid_shape(side, side, 0.5, n, **vessel)
         assert side / ncx >= 0.5 and side / ncy >= 0.5
         return ncx * ncy / n
 
     small, large = cells.SMALL_SCENE - 1, cells.SMALL_SCENE
     assert 0.9 * 6 < cells_per_particle(small, 100.0) <= cells.SMALL_SCENE_CELLS_PER_PARTICLE == 6
     assert 0.9 * 3 < cells_per_particle(large, 100.0) <= cells.EVENT_CELLS_PER_PARTICLE == 3
+    # where a crossing costs more: under a gravity the engine carries, or with segments
+    assert 0.9 * 3 < cells_per_particle(small, 100.0, falls=True) <= 3
+    assert 0.9 * 3 < cells_per_particle(small, 100.0, segments=6) <= 3
     # dense: cells of one diameter, about 2.4 a particle, whatever the size
     assert cells_per_particle(small, 0.6) == pytest.approx(2.4, rel=0.02)
     assert cells_per_particle(large, 0.6) == pytest.approx(2.4, rel=0.02)

@@ -245,23 +245,35 @@ def grid_shape(width: float, height: float, max_diameter: float, n: int) -> tupl
 EVENT_CELLS_PER_PARTICLE = 3
 
 #: Cells per particle at most in the grid of a scene of fewer than `SMALL_SCENE` particles,
-#: whose arrays stay in the caches: smaller cells there leave fewer pairs to test at each
-#: prediction (pool-break 7-11% faster than with 3, piston 3-4%, the other presets within 2%).
-#: From about 1e4 particles on, the grid's own memory traffic costs more than the pairs it
-#: spares.
+#: whose arrays stay in the caches, with no gravity: smaller cells there leave fewer pairs to
+#: test at each prediction (pool-break 7-11% faster than with 3, piston 3-4%, the other presets
+#: within 2%). From about 1e4 particles on, the grid's own memory traffic costs more than the
+#: pairs it spares. Where a crossing costs more, the extra crossings cost more than they spare:
+#: under a gravity the engine carries, where a disk meets a cell's edge at a root of a
+#: quadratic (atmosphere 10% slower), and in a vessel with segments, which every prediction
+#: tests (effusion 3% slower).
 SMALL_SCENE_CELLS_PER_PARTICLE = 6
 
 #: Particles from which the event grid takes `EVENT_CELLS_PER_PARTICLE`.
 SMALL_SCENE = 16_384
 
 
-def event_grid_shape(width: float, height: float, max_diameter: float, n: int) -> tuple[int, int]:
+def event_grid_shape(
+    width: float,
+    height: float,
+    max_diameter: float,
+    n: int,
+    falls: bool = False,
+    segments: int = 0,
+) -> tuple[int, int]:
     """Cells along x and y of a window (m) for the event engine: as small as one largest
     diameter (the fewest neighbours to test per prediction; measured fastest at packing 0.3), at
-    most `SMALL_SCENE_CELLS_PER_PARTICLE` cells per particle below `SMALL_SCENE` particles and
-    `EVENT_CELLS_PER_PARTICLE` from there on."""
+    most `SMALL_SCENE_CELLS_PER_PARTICLE` cells per particle below `SMALL_SCENE` particles that
+    do not fall (under a gravity the engine carries: ``falls``) in a vessel without
+    ``segments``, and `EVENT_CELLS_PER_PARTICLE` otherwise."""
     if max_diameter <= 0.0:
         return 1, 1
-    per_particle = SMALL_SCENE_CELLS_PER_PARTICLE if n < SMALL_SCENE else EVENT_CELLS_PER_PARTICLE
+    small = n < SMALL_SCENE and not falls and segments == 0
+    per_particle = SMALL_SCENE_CELLS_PER_PARTICLE if small else EVENT_CELLS_PER_PARTICLE
     size = max(max_diameter, math.sqrt(width * height / (per_particle * max(n, 1))))
     return max(1, int(width // size)), max(1, int(height // size))
