@@ -477,7 +477,7 @@ class Simulation:
         starts from), or the vessel has a piston (the record holds none, and the vessel changes
         as it moves: a flight then stops at every observer's firing)."""
         return (
-            not hasattr(observer, "take_flown")
+            not _only_reads(observer)
             or not getattr(observer, "sampled", True)
             or self.tally.piston.size > 0
         )
@@ -538,7 +538,7 @@ class Simulation:
 
     def _step(self) -> bool:
         """One step, its audit and its observers; returns whether an observer fired that may
-        have changed the particles (one without ``take_flown``: those only read, `Observer`)."""
+        have changed the particles (one that does not only read: `_only_reads`)."""
         try:
             self._integrator.step(
                 self.particles, self.container, self._field, self._drift, self.time, self.dt,
@@ -552,7 +552,7 @@ class Simulation:
         for observer in self.observers:
             if observer.trigger(self):
                 observer.update(self)
-                touched |= not hasattr(observer, "take_flown")
+                touched |= not _only_reads(observer)
         return touched
 
     def _audit(self) -> None:
@@ -955,3 +955,9 @@ def _check_placement(
     if i >= 0:
         detail = overlap_detail(container, particles, i, j)
         raise InputError("position", f"particles {i} and {j} overlap {detail}", particles=(i, j))
+
+
+def _only_reads(observer: Observer) -> bool:
+    """Whether ``observer`` only reads the state: one with ``take_flown``, which a flight
+    passes by and hands what it would have read (the `Observer` protocol). Others may write."""
+    return hasattr(observer, "take_flown")
