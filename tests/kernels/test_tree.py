@@ -11,7 +11,13 @@ import pytest
 
 from collidium.kernels import reference
 from collidium.kernels.pairwise import inverse_distance_direct
-from collidium.kernels.tree import LEAF_SIZE, THETA, inverse_distance_tree, tree_buffers
+from collidium.kernels.tree import (
+    LEAF_SIZE,
+    THETA,
+    acceleration_stiffness,
+    inverse_distance_tree,
+    tree_buffers,
+)
 
 K = 5.0
 
@@ -200,3 +206,30 @@ def test_buffers_grow_for_a_tree_with_many_small_leaves(rng):
     got = _tree(position[:500], charge[:500], 1e-4, buffers=buffers)
     assert buffers["order"].shape == (500,)
     assert _rms_relative_force_error(got[0], _direct(position[:500], charge[:500], 1e-4)[0]) < 1e-3
+
+
+@pytest.mark.parametrize("radius, softening", [(0.1, 0.05), (0.01, 0.05), (0.0, 0.0)])
+def test_acceleration_stiffness_equals_numpy_twin(rng, radius, softening):
+    # Disks wider than the softening, softened points, and bare points (the mean spacing).
+    n = 500
+    velocity = rng.normal(0, 2, (n, 2))
+    acceleration = rng.normal(0, 50, (n, 2))
+    mass = rng.uniform(0.5, 2, n)
+    radii = np.full(n, radius)
+    args = (velocity, acceleration, mass, radii, softening, 0.3)
+    got = acceleration_stiffness(*args)
+    assert got > 0.0
+    assert got == pytest.approx(reference.acceleration_stiffness(*args), rel=1e-14)
+    # The largest term: raising one particle's pull raises the result to that particle's.
+    acceleration[7] = 1e4
+    assert acceleration_stiffness(*args) == pytest.approx(
+        reference.acceleration_stiffness(*args), rel=1e-14
+    )
+    assert acceleration_stiffness(*args) > got
+
+
+def test_acceleration_stiffness_keeps_a_nan():
+    # A non-finite acceleration must reach the substep rate, which then refuses the step.
+    acceleration = np.array([[1.0, 0.0], [np.nan, 0.0], [2.0, 0.0]])
+    got = acceleration_stiffness(np.ones((3, 2)), acceleration, np.ones(3), np.ones(3), 0.0, 1.0)
+    assert np.isnan(got)

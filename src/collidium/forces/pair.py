@@ -120,10 +120,8 @@ def pair_stiffness(
 
     Summed directly, the largest ``(|U_ij| rate_ij^2)^2`` over pairs
     (`collidium.kernels.pairwise.inverse_distance_stiffness`), O(N^2) like the sum itself.
-    Summed by tree, which has no pair list, the same from each particle's acceleration ``|a_i|``
-    (``acceleration`` (N, 2), m/s^2, of all forces) and speed over ``l_i``, its diameter or the
-    softening length, whichever is larger (the mean spacing for point particles without
-    softening): ``|U_i| = m_i |a_i| l_i`` and ``rate_i^2 = (|v_i|^2 / l_i + |a_i|) / l_i``.
+    Summed by tree, which has no pair list, the same from each particle's acceleration
+    (``acceleration`` (N, 2), m/s^2, of all forces): `tree.acceleration_stiffness`.
     """
     if not uses_tree(method, particles, vessel):
         width, height = (float(side) for side in vessel.size)
@@ -131,13 +129,11 @@ def pair_stiffness(
             particles.position, particles.velocity, source, writable(particles.mass), coupling,
             softening**2, width, height, vessel.periodic,
         )  # fmt: skip
-    length = np.maximum(2.0 * particles.radius, softening)
     spacing = math.sqrt(vessel.area / max(particles.n, 1))
-    length = np.where(length > 0.0, length, spacing)
-    pull = np.hypot(acceleration[:, 0], acceleration[:, 1])
-    speed2 = np.einsum("ij,ij->i", particles.velocity, particles.velocity)
-    error = particles.mass * pull * (speed2 / length + pull)
-    return float(np.max(error * error, initial=0.0))
+    return tree.acceleration_stiffness(
+        particles.velocity, acceleration, writable(particles.mass), writable(particles.radius),
+        softening, spacing,
+    )  # fmt: skip
 
 
 class InverseDistanceForce:

@@ -108,6 +108,25 @@ def inverse_distance_stiffness(
     return float(np.max(error[np.triu_indices(q.size, 1)] ** 2, initial=0.0))
 
 
+def acceleration_stiffness(
+    velocity: FloatArray,
+    acceleration: FloatArray,
+    mass: FloatArray,
+    radius: FloatArray,
+    softening: float,
+    spacing: float,
+) -> float:
+    """Twin of `tree.acceleration_stiffness`: the largest ``(m_i |a_i| l_i rate_i^2)^2`` with
+    ``rate_i^2 = (|v_i|^2 / l_i + |a_i|) / l_i`` and ``l_i`` the diameter or the softening,
+    whichever is larger, else ``spacing``."""
+    length = np.maximum(2.0 * radius, softening)
+    length = np.where(length > 0.0, length, spacing)
+    pull = np.hypot(acceleration[:, 0], acceleration[:, 1])
+    speed2 = np.einsum("ij,ij->i", velocity, velocity)
+    error = mass * pull * (speed2 / length + pull)
+    return float(np.max(error * error, initial=0.0))
+
+
 def kick_timing_correction(
     contacts: FloatArray,
     start_time: float,

@@ -73,7 +73,7 @@ import math
 import numba
 import numpy as np
 
-from collidium.kernels.pairwise import inverse_distance_pair
+from collidium.kernels.pairwise import inverse_distance_pair, larger
 from collidium.kernels.sorting import radix_sort
 
 THETA = 0.3
@@ -805,6 +805,42 @@ def evaluate_tree(
                 force[j, 1] = kq * (ey + fy)
                 energy[j] = 0.5 * kq * (phi + far_phi)
                 virial[j] = 0.5 * kq * (w + far_w)
+
+
+@numba.njit(cache=True)
+def acceleration_stiffness(
+    velocity: np.ndarray,
+    acceleration: np.ndarray,
+    mass: np.ndarray,
+    radius: np.ndarray,
+    softening: float,
+    spacing: float,
+) -> float:
+    """The largest ``(|U_i| rate_i^2)^2`` (J^2/s^4) over particles, estimated from each one's
+    acceleration, for a pair force summed by tree (which has no pair list to take it from).
+
+    ``l_i`` is the particle's diameter or ``softening``, whichever is larger, or ``spacing``
+    when both are 0; ``|U_i| = m_i |a_i| l_i`` and ``rate_i^2 = (|v_i|^2 / l_i + |a_i|) / l_i``.
+
+    Parameters
+    ----------
+    velocity, acceleration : ndarray, shape (N, 2)
+        In m/s and m/s^2 (of all forces).
+    mass, radius : ndarray, shape (N,)
+        In kg and m.
+    softening, spacing : float
+        The softening length and the mean spacing of the particles, m.
+    """
+    largest = 0.0
+    for i in range(velocity.shape[0]):
+        length = max(2.0 * radius[i], softening)
+        if not length > 0.0:
+            length = spacing
+        pull = math.sqrt(acceleration[i, 0] ** 2 + acceleration[i, 1] ** 2)
+        speed2 = velocity[i, 0] * velocity[i, 0] + velocity[i, 1] * velocity[i, 1]
+        error = mass[i] * pull * (speed2 / length + pull)
+        largest = larger(largest, error * error)
+    return largest
 
 
 # --------------------------------------------------------------------------------------------
