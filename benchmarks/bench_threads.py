@@ -10,12 +10,19 @@ T1  the direct inverse-distance sum (`collidium.kernels.pairwise`): microseconds
     process per core, which this script starts and stops. Both give the same bits;
     `inverse_distance_direct` switches at ``PARALLEL_DIRECT_FROM``.
 T2  the same for the adaptive substeps' stiffness (`stiffness_serial`, `stiffness_parallel`).
+T3  what numba's idle OpenMP threads cost: 300 steps of a 1e5-disk gas at packing 0.1 (the
+    viewer's), wall seconds and the CPU seconds of the whole process, with collidium's spin
+    count (`collidium.kernels.OPENMP_SPINS`) and with GNU OpenMP's default (300,000), each in a
+    process of its own (the count is read when the threads start), alternated ``--rounds``
+    times.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import subprocess
 import sys
 import time
 from collections.abc import Callable
@@ -25,7 +32,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from collidium.kernels import pairwise
+from collidium.kernels import OPENMP_SPINS, pairwise
 
 sys.path.insert(0, str(Path(__file__).parent))
 from machine import busy_cores
@@ -75,10 +82,40 @@ def kernel_rows(n: int, repeats: int) -> list[dict[str, Any]]:
     return rows
 
 
+#: T3's child: the gas, a warm-up, then wall and CPU seconds (all threads) of the steps.
+_SPIN_CHILD = """
+import math, time
+import collidium as cd
+side = round(math.sqrt(100_000 * math.pi * 0.25**2 / 0.1), 1)
+sim = cd.load("gas", n=100_000, **{"vessel.width": side, "vessel.height": side})
+sim.run(steps=5)
+wall, cpu = time.perf_counter(), time.process_time()
+sim.run(steps=300)
+print(time.perf_counter() - wall, time.process_time() - cpu)
+"""
+
+#: GNU OpenMP's own spin count, when the environment sets none.
+GNU_DEFAULT_SPINS = 300_000
+
+
+def idle_spin_rows(rounds: int) -> list[dict[str, Any]]:
+    """T3: wall and CPU seconds of the gas's steps with each spin count, alternated."""
+    rows = []
+    for _ in range(rounds):
+        for spins in (OPENMP_SPINS, GNU_DEFAULT_SPINS):
+            env = os.environ | {"GOMP_SPINCOUNT": str(spins)}
+            out = subprocess.run([sys.executable, "-c", _SPIN_CHILD], env=env, check=True,
+                                 capture_output=True, text=True).stdout  # fmt: skip
+            wall, cpu = (float(x) for x in out.split())
+            rows.append({"spins": spins, "wall_s": wall, "cpu_s": cpu})
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[2, 32, 128, 256, 512, 1024])
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--rounds", type=int, default=3, help="T3's alternated rounds")
     args = parser.parse_args()
     rows: list[dict[str, Any]] = []
     rows += [row | {"load": "quiet"} for n in args.sizes for row in kernel_rows(n, args.repeats)]
@@ -93,8 +130,12 @@ def main() -> None:
         ratio = row["parallel_us"] / row["serial_us"]
         print(f"{row['kernel']:<16}{row['load']:>6}{row['n']:>7}{row['serial_us']:>12.1f}"
               f"{row['parallel_us']:>13.1f}{ratio:>9.2f}")  # fmt: skip
+    spins = idle_spin_rows(args.rounds)
+    print(f"\nT3 300 steps of a 1e5-disk gas: {'spins':>9}{'wall s':>9}{'CPU s':>8}")
+    for row in spins:
+        print(f"{'':<35}{row['spins']:>9}{row['wall_s']:>9.2f}{row['cpu_s']:>8.2f}")
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "threads.json").write_text(json.dumps(rows, indent=1) + "\n")
+    (RESULTS / "threads.json").write_text(json.dumps(rows + spins, indent=1) + "\n")
 
 
 if __name__ == "__main__":
