@@ -64,7 +64,7 @@ def kernel_rows(n: int, repeats: int) -> list[dict[str, Any]]:
     charge = rng.choice([-1.0, 1.0], n)
     mass = np.ones(n)
     force, energy, virial = np.empty((n, 2)), np.empty(n), np.empty(n)
-    direct = (position, charge, 1.0, 0.01, 20.0, 20.0, False, force, energy, virial)
+    direct = (position, charge, 1.0, 0.01, 20.0, 20.0, False, force, energy, virial, True)
     stiffness = (position, velocity, charge, mass, 1.0, 0.01, 20.0, 20.0, False)
     rows = []
     for name, serial, parallel, args in (
