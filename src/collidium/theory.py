@@ -32,11 +32,11 @@ class MaxwellBoltzmann2D:
     def __init__(self, kT: float, mass: ArrayLike) -> None:
         if not np.isfinite(kT) or kT <= 0:
             raise InputError("temperature", f"must be a finite number > 0, got {kT!r}")
-        mass = np.atleast_1d(np.asarray(mass, dtype=float))
-        if mass.size and mass.min() == mass.max():  # one mass: no sort of N masses
-            masses, counts = mass[:1], np.array([mass.size])
+        each: FloatArray = np.atleast_1d(np.asarray(mass, dtype=float))
+        if each.size and each.min() == each.max():  # one mass: no sort of N masses
+            masses, counts = each[:1], np.array([each.size])
         else:
-            masses, counts = np.unique(mass, return_counts=True)
+            masses, counts = np.unique(each, return_counts=True)
         self.kT = float(kT)
         self.masses = masses
         self.weights = counts / counts.sum()
