@@ -82,12 +82,13 @@ def kernel_rows(n: int, repeats: int) -> list[dict[str, Any]]:
     return rows
 
 
-#: T3's child: the gas, a warm-up, then wall and CPU seconds (all threads) of the steps.
-_SPIN_CHILD = """
-import math, time
-import collidium as cd
-side = round(math.sqrt(100_000 * math.pi * 0.25**2 / 0.1), 1)
-sim = cd.load("gas", n=100_000, **{"vessel.width": side, "vessel.height": side})
+#: T3's child: the viewer's gas (`bench_viewer.gas`), a warm-up, then wall and CPU seconds (all
+#: threads) of the steps.
+_SPIN_CHILD = f"""
+import sys, time
+sys.path.insert(0, {str(Path(__file__).parent)!r})
+from bench_viewer import gas
+sim = gas(100_000).sim
 sim.run(steps=5)
 wall, cpu = time.perf_counter(), time.process_time()
 sim.run(steps=300)

@@ -40,10 +40,13 @@ class MaxwellBoltzmann2D:
         self.kT = float(kT)
         self.masses = masses
         self.weights = counts / counts.sum()
-        #: The Rayleigh scale ``sqrt(kT / m)`` of each mass, m/s. The laws are scipy's
-        #: ``rayleigh`` at these scales, called unfrozen: freezing one builds a distribution
-        #: object, a hundred times the cost of a density (the viewer draws one a readout).
-        self.scales = np.sqrt(kT / masses)
+
+    @property
+    def scales(self) -> FloatArray:
+        """The Rayleigh scale ``sqrt(kT / m)`` of each mass, m/s. The laws are scipy's
+        ``rayleigh`` at these scales, called unfrozen: freezing one builds a distribution
+        object, a hundred times the cost of a density (the viewer draws one a readout)."""
+        return np.sqrt(self.kT / self.masses)
 
     def pdf(self, speed: ArrayLike) -> FloatArray:
         """Probability density at ``speed`` (m/s), in s/m."""
