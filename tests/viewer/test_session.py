@@ -41,21 +41,29 @@ def test_advance_runs_speed_times_the_wall_time_in_whole_steps(gas):
     assert gas.sim.steps == 21
 
 
-def test_advance_gives_up_time_it_cannot_afford_and_never_runs_while_paused(gas):
+def test_advance_owes_the_time_it_cannot_afford_up_to_a_limit_and_never_runs_while_paused(gas):
     gas._seconds_per_step = 1.0  # as if each step took a second
     gas.advance(0.2, budget=0.01)
-    assert gas.sim.steps == 1  # one step, not the 20 asked for; the backlog is dropped
+    assert gas.sim.steps == 1  # one step, not the 20 asked for...
+    gas._seconds_per_step = 1e-6
+    gas.advance(0.0, budget=10.0)
+    assert gas.sim.steps == 20  # ...the 19 owed follow once they fit
+    gas._seconds_per_step = 1.0
+    gas.advance(10.0, budget=0.01)  # a backlog past MAX_CATCH_UP is dropped
+    gas._seconds_per_step = 1e-6
+    gas.advance(0.0, budget=10.0)
+    assert gas.sim.steps == 20 + round(session_module.MAX_CATCH_UP / gas.sim.dt)
     gas.playing = False
     gas.advance(0.2, budget=10.0)
-    assert gas.sim.steps == 1
+    assert gas.sim.steps == 20 + round(session_module.MAX_CATCH_UP / gas.sim.dt)
 
 
-def test_advance_spends_the_nearest_whole_number_of_steps_to_its_budget(gas):
-    gas._seconds_per_step = 0.6  # a step just over half the budget: two fit it best
+def test_advance_runs_as_many_whole_steps_as_fit_its_budget(gas):
+    gas._seconds_per_step = 0.6  # a step over half the budget: one fits
     gas.advance(0.2, budget=1.0)
-    assert gas.sim.steps == 2
-    gas._seconds_per_step = 0.9  # but not a third, which would overspend it by 35%
-    gas.advance(0.2, budget=2.0)
+    assert gas.sim.steps == 1
+    gas._seconds_per_step = 0.9  # three fit (2.7 s), a fourth would overspend
+    gas.advance(0.0, budget=3.0)
     assert gas.sim.steps == 4
 
 

@@ -23,8 +23,11 @@ Outgoing = dict[str, Any] | bytes
 MAX_CREDIT = 2
 #: Wall-clock seconds between readout updates while the state changes.
 STATS_PERIOD = 0.2
-#: Computation one tick may spend running the simulation, s (leaves time for 30+ frames/s).
-TICK_BUDGET = 0.02
+#: Frames a second the page gets at the least, while the simulation keeps pace or not.
+LEAST_FRAME_RATE = 30
+#: Computation one tick may spend running the simulation, s: a frame's period at
+#: `LEAST_FRAME_RATE` less 5 ms for the frame, the readouts and their sending.
+TICK_BUDGET = 1 / LEAST_FRAME_RATE - 0.005
 #: A front end that has acknowledged nothing for this long, s, with frames outstanding, is not
 #: watching (a hidden tab, a closed notebook view): the simulation waits for it.
 STALL_SECONDS = 1.0

@@ -37,7 +37,8 @@ HISTOGRAM_BINS = 30
 #: Pressure and collision rate are averages over this many intervals between stats samples (the
 #: pressure's error is that of their block average).
 WINDOW_SAMPLES = 5
-#: Longest wall-clock gap one `advance` makes up for, s (longer pauses are not caught up).
+#: Most wall-clock time the simulation may owe, s: a backlog beyond it (a long pause, steps
+#: slower than real time) is dropped, not caught up.
 MAX_CATCH_UP = 0.25
 #: A step that takes longer than this, in s, pauses the session with an error (dt or N is too
 #: large for a live view).
@@ -334,9 +335,10 @@ class ViewerSession:
     # -- running ----------------------------------------------------------------------------
 
     def advance(self, wall_seconds: float, budget: float) -> None:
-        """Run for ``wall_seconds`` times the speed of simulated time, in whole steps, spending
-        about ``budget`` s of computation at most (the whole number of steps nearest to it; the
-        simulation then runs slower than asked).
+        """Run for ``wall_seconds`` times the speed of simulated time, in whole steps: as many
+        of those owed as fit ``budget`` s of computation (at least one). Time not run is owed
+        to the next calls, up to `MAX_CATCH_UP` s of wall-clock time; past that the simulation
+        runs slower than asked.
 
         Raises
         ------
@@ -346,21 +348,17 @@ class ViewerSession:
         if not self.playing:
             return
         dt = self.sim.dt
-        self._carry += min(wall_seconds, MAX_CATCH_UP) * self.speed
+        owed = self._carry + wall_seconds * self.speed  # simulated s
+        self._carry = min(owed, MAX_CATCH_UP * self.speed)
         wanted = self._carry / dt + 1e-9  # the slack keeps whole multiples whole
         if wanted < 1:
             return
         per_step = self._seconds_per_step
-        if per_step is None:  # one step first, to learn what a step costs
-            count = 1
-            self._carry -= dt
-        # The nearest whole number of steps to the budget, not the floor: a step just over half
-        # the budget (a 1e5-disk gas's 11 ms of 20) would otherwise spend half of it.
-        elif wanted >= (affordable := max(1, round(budget / max(per_step, 1e-9)))) + 1:
-            count, self._carry = affordable, 0.0  # more than affordable: run slower than asked
-        else:
-            count = int(wanted)
-            self._carry -= count * dt
+        # Owed time is kept, not dropped: the time lost to a tick that ran long (another
+        # program took the core) is made up by the next ones, which fit more steps than keep pace.
+        fit = 1 if per_step is None else max(1, int(budget / max(per_step, 1e-9)))
+        count = fit if wanted >= fit else int(wanted)  # (wanted may be inf: a tiny dt)
+        self._carry -= count * dt
         start = clock.perf_counter()
         self._run(count)
         spent = (clock.perf_counter() - start) / count
