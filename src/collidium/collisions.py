@@ -141,8 +141,9 @@ class ContactLog:
     ----------
     rows : ndarray, shape (K, `collidium.kernels.events.LOG_COLUMNS`)
         One row per contact in the order they happened: the particle, its partner (or ``-1 -
-        wall``), the time (s), the contact normal (m) and the response's ``1 + e``
-        (`collidium.kernels.events.run_events`).
+        wall``), the time (s), the contact normal (m), the response's ``1 + e`` and the
+        particle's velocity change (m/s) (`collidium.kernels.events.run_events`), then the
+        columns the correction works in.
     count : ndarray of int64, shape (1,)
         Contacts met since the last `clear`; more than K when they did not all fit.
     """

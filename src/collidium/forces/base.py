@@ -116,6 +116,11 @@ class PairLawForce(PositionForce, Protocol):
         """``(sources (N,), coupling, squared softening in m^2)`` of the law
         ``U_ij = c s_i s_j / sqrt(r^2 + eps^2)`` (`collidium.kernels.pairwise`)."""
 
+    def follows_law(self, particles: Particles, vessel: Vessel) -> bool:
+        """Whether the force summed here is exactly the gradient of the law's energy (summed
+        directly, nothing capping it): what the contacts' modified-energy term of
+        `collidium.kernels.kick_timing` needs."""
+
 
 @runtime_checkable
 class UniformPositionForce(PositionForce, Protocol):
@@ -545,6 +550,11 @@ class ForceField:
         couplings = np.array([law[1] for law in laws], dtype=float)
         softenings2 = np.array([law[2] for law in laws], dtype=float)
         return sources, couplings, softenings2
+
+    def follows_laws(self, particles: Particles, vessel: Vessel) -> bool:
+        """Whether every inverse-distance pair force is summed as its law's gradient
+        (`PairLawForce.follows_law`)."""
+        return all(force.follows_law(particles, vessel) for force in self._pair_laws)
 
     def stiffness(self, particles: Particles, vessel: Vessel) -> float:
         """``S`` of all forces at the current state, in J^2/s^4: the largest of the forces'

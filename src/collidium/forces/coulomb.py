@@ -85,6 +85,10 @@ class Coulomb(InverseDistanceForce):
             pull = np.hypot(force[:, 0], force[:, 1]) / particles.mass
             force /= np.sqrt(1.0 + (pull / self.max_acceleration) ** 2)[:, None]
 
+    def follows_law(self, particles: Particles, vessel: Vessel) -> bool:
+        """Whether the force is the law's gradient: summed directly, without a limiter."""
+        return self.max_acceleration is None and super().follows_law(particles, vessel)
+
     def direct_term(self, particles: Particles, vessel: Vessel) -> tuple[str, float, float] | None:
         """The direct sum's terms (`InverseDistanceForce.direct_term`), none with a limiter."""
         if self.max_acceleration is not None:

@@ -189,6 +189,11 @@ class InverseDistanceForce:
         (`collidium.forces.base.PairLawForce`)."""
         return getattr(particles, self.source), self.coupling, self.softening**2
 
+    def follows_law(self, particles: Particles, vessel: Vessel) -> bool:
+        """Whether the sum is the law's own gradient: direct, not by tree
+        (`collidium.forces.base.PairLawForce`)."""
+        return not uses_tree(self.method, particles, vessel)
+
     def direct_term(self, particles: Particles, vessel: Vessel) -> tuple[str, float, float] | None:
         """The sources' property, coupling and squared softening when the sum is direct and
         not periodic (`collidium.forces.base.DirectPairForce`)."""

@@ -91,9 +91,14 @@ SLOT_COLUMNS = EVENT_COLUMNS + 4
 #: partner (or ``-1 - wall``, `collidium.vessels.Vessel.wall_names` order), the time (s), the
 #: contact normal (the line of centres ``x_i - x_j``, or the wall's outward unit normal, m), and
 #: the factor by which the response changed the normal velocity, ``1 + e`` (0 where the kick-timing
-#: correction was not applied: a wall that is not a mirror, a piston, a pair still approaching).
-LOG_PARTICLE, LOG_PARTNER, LOG_TIME, LOG_NX, LOG_NY, LOG_BOUNCE = range(6)
-LOG_COLUMNS = 6
+#: correction was not applied: a wall that is not a mirror, a piston, a pair still approaching),
+#: and the change of the particle's velocity (m/s; its partner's is the opposite impulse).
+LOG_PARTICLE, LOG_PARTNER, LOG_TIME, LOG_NX, LOG_NY, LOG_BOUNCE, LOG_DVX, LOG_DVY = range(8)
+#: Columns the kick-timing correction works in (`collidium.kernels.kick_timing.correct`): the
+#: velocity errors of the particle and its partner just after the contact (4, m/s), their
+#: accelerations at it (4, m/s^2), and the contact's jump of the modified energy (J).
+LOG_ERROR, LOG_PULL, LOG_DROP = 8, 12, 16
+LOG_COLUMNS = 17
 
 #: Children per node of the event queue's heap: 8 keys fill one 64-byte line, and the heap is a
 #: third as deep as a binary one.
@@ -805,9 +810,11 @@ def run_events(
                               count, event, segments, piston)  # fmt: skip
                 heap_update(j, t_j, keys, items, where)
         elif piston.shape[0] > 0 and code == FIRST_WALL_CODE - piston[pistons.WALL]:
+            old_x, old_y = body[k, VX], body[k, VY]
             _push_piston(k, t, body, ident, geometry, tally, impulse, heat, piston)
             if acceleration.shape[0] > 0:
-                _log_contact(log, logged, ident[k], -1 - piston[pistons.WALL], t, 0.0, 0.0, 0.0)
+                _log_contact(log, logged, ident[k], -1 - piston[pistons.WALL], t, 0.0, 0.0, 0.0,
+                             body[k, VX] - old_x, body[k, VY] - old_y)  # fmt: skip
             count[k] += 1
             pushed = True
         elif code <= FIRST_WALL_CODE:
@@ -870,8 +877,9 @@ def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count,
 
 
 @inlined
-def _log_contact(log, logged, particle, partner, t, nx, ny, bounce) -> None:
-    """Write a contact into the next row of ``log`` if there is one (`run_events`)."""
+def _log_contact(log, logged, particle, partner, t, nx, ny, bounce, dvx, dvy) -> None:
+    """Write a contact into the next row of ``log`` if there is one (`run_events`): ``dvx``,
+    ``dvy`` the change of the particle's velocity (m/s; the partner's is the opposite impulse)."""
     row = logged[0]
     if row < log.shape[0]:
         log[row, LOG_PARTICLE] = particle
@@ -880,6 +888,8 @@ def _log_contact(log, logged, particle, partner, t, nx, ny, bounce) -> None:
         log[row, LOG_NX] = nx
         log[row, LOG_NY] = ny
         log[row, LOG_BOUNCE] = bounce
+        log[row, LOG_DVX] = dvx
+        log[row, LOG_DVY] = dvy
     logged[0] = row + 1
 
 
@@ -908,7 +918,8 @@ def _collide(k, j, t, body, ident, geometry, grid, tally, impulse, acceleration,
         k, j, nx, ny, midpoint - t, body, ident, geometry, acceleration
     )
     if acceleration.shape[0] > 0:
-        _log_contact(log, logged, ident[k], ident[j], t, nx, ny, bounce)
+        _log_contact(log, logged, ident[k], ident[j], t, nx, ny, bounce, v1x - body[k, VX],
+                     v1y - body[k, VY])  # fmt: skip
     m1, m2 = _mass(k, body, geometry), _mass(j, body, geometry)
     impulse[PAIR_COLLISIONS] += m1 * (nx * (v1x - body[k, VX]) + ny * (v1y - body[k, VY]))
     if geometry[RESTITUTION] != 1.0:
@@ -937,13 +948,14 @@ def _bounce(k, contact, t, body, ident, geometry, tally, impulse, acceleration, 
                                         segments)  # fmt: skip
     body[k, X] = x
     body[k, Y] = y
+    old_x, old_y = body[k, VX], body[k, VY]
     if walls[wall, wall_responses.RESPONSE] != wall_responses.SPECULAR:
         vx, vy = wall_responses.hit(walls, wall, body[k, VX], body[k, VY], nx, ny, m, ident[k],
                                     tally, impulse, heat, WALL_HITS + wall)  # fmt: skip
         body[k, VX] = vx
         body[k, VY] = vy
         if acceleration.shape[0] > 0:
-            _log_contact(log, logged, ident[k], -1 - wall, t, nx, ny, 0.0)
+            _log_contact(log, logged, ident[k], -1 - wall, t, nx, ny, 0.0, vx - old_x, vy - old_y)
         return
     forced = acceleration.shape[0] > 0
     if geometry[SHAPE] == BOX and contact < contacts.SEGMENTS_FROM:
@@ -968,7 +980,8 @@ def _bounce(k, contact, t, body, ident, geometry, tally, impulse, acceleration, 
         impulse[WALL_HITS + wall] += m * abs(change)
     tally[WALL_HITS + wall] += 1
     if forced:
-        _log_contact(log, logged, ident[k], -1 - wall, t, nx, ny, 2.0 if corrected else 0.0)
+        _log_contact(log, logged, ident[k], -1 - wall, t, nx, ny, 2.0 if corrected else 0.0,
+                     body[k, VX] - old_x, body[k, VY] - old_y)  # fmt: skip
 
 
 @inlined

@@ -9,34 +9,63 @@ engine's response takes out the first-order error, ``v' = C(v - delta) + delta``
 leaves an error of O(h^2) per contact, which in a charged gas, where the pair in contact pulls
 hardest, is most of the energy error.
 
-`correct` adds the rest once the accelerations at the substep's end are known: for a particle
-whose acceleration goes linearly from ``a0`` to ``a_c`` at the contact and from there linearly to
-``aH``, the velocity at the end is the kick-drift-kick one plus
+`correct` adds the rest once the accelerations at the substep's end are known. It carries each
+particle's velocity error, the impulse its acceleration gave beyond the kick's constant ``a0``,
+from contact to contact in the order they happened: linear in time between ``a0`` at the
+start, its accelerations ``a_c`` at its contacts and ``aH`` at the end, and through each
+contact's map C (of a pair, on both particles' errors). At the end the velocity is the
+kick-drift-kick one plus that error and ``(a0 - aH) h / 2``; for a single contact,
 
     X = C[(a_c - a0) tau / 2] + a_c (h - tau) / 2 - aH tau / 2 + a0 (tau - h / 2),
 
-which is 0 for a constant acceleration (C[.] of a pair acts on both particles' vectors). The
-acceleration at the contact ``a_c`` is the pair's mutual inverse-distance forces at the contact
-separation, which peak there, plus the rest of each particle's acceleration interpolated
-linearly over the substep; a wall contributes no force of its own. A charged gas of 200 disks
-(the seed's) with 16 substeps per 0.01 s drifts by 3e-6 of its energy over 60 s, against 1e-4
-over 10 s with the first-order response alone.
+which is 0 for a constant acceleration. The acceleration at the contact ``a_c`` is the pair's
+mutual inverse-distance forces at the contact separation, which peak there, plus the rest of
+each particle's acceleration interpolated linearly over the substep; a wall contributes no
+force of its own. Carrying the error, rather than adding each contact's ``X``, keeps a
+particle in two contacts of a substep (a chain, or a pair that meets twice) at second order.
+
+The modified energy. Between contacts kick-drift-kick keeps not the energy H but its modified
+energy ``S = H + h^2/12 sum_pairs w . Hess(U) . w - h^2/24 sum |F|^2/m`` (w a pair's relative
+velocity; to O(h^4)): H oscillates about S by O(h^2) and does not drift. A contact that keeps H
+makes S jump, by (derived to leading order for a mirror under a quadratic potential, and
+measured on the seed's charged gas)
+
+    (h^2 - 3 tau (h - tau)) / 12 dQ - tau (h - tau) (h - 2 tau) / (4 h) dv . Hess_o . dv,
+
+``dQ`` the change of ``sum_pairs w . Hess(U) . w`` by the contact's velocity changes ``dv``
+and ``Hess_o`` the Hessian of the particles' pulls from the others (not the pair's own, whose
+force at the contact is exact). Two contacts of a substep add ``t (h - tau) (tau + t - h) /
+(2 h) dv_1 . Hess . dv_2`` (``t < tau`` their times). These jumps, of random sign, random-walk S
+and H with it: in the seed's charged gas at 8 substeps a 0.01 s step they were the whole of
+the energy's drift, the substeps between contacts keeping S to 1e-10 of the energy each.
+`correct` takes each contact's jump from the kinetic energy of its normal motion (the pair's
+relative one, momentum kept), so that S goes through it to O(h^3); a single contact's jump
+then falls eightfold per halving of h, not fourfold. Only where the pair forces are summed as
+their laws' gradients (directly, uncapped; `collidium.forces.base.PairLawForce.follows_law`):
+a tree's or a limiter's forces have no such S.
 
 The positions after the contact, drifted with the first-order velocities, are off by O(h^3).
 """
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
-from collidium.kernels.compilation import uncounted
+from collidium.kernels.compilation import inlined, uncounted
 from collidium.kernels.events import (
     LOG_BOUNCE,
+    LOG_DROP,
+    LOG_DVX,
+    LOG_DVY,
+    LOG_ERROR,
     LOG_NX,
     LOG_NY,
     LOG_PARTICLE,
     LOG_PARTNER,
+    LOG_PULL,
     LOG_TIME,
 )
 from collidium.kernels.pairwise import inverse_distance_pair
@@ -60,16 +89,19 @@ def correct(
     width: float,
     height: float,
     periodic: bool,
+    shadow: bool,
 ) -> None:
-    """Add the second-order kick-timing correction ``X`` of each contact of a substep to the
-    velocities of its particles, in place.
+    """Add the second-order kick-timing correction of a substep's contacts to the velocities of
+    their particles, in place, and with ``shadow`` take each contact's jump of the modified
+    energy from its normal motion (module docstring).
 
     Parameters
     ----------
     contacts : ndarray, shape (K, `collidium.kernels.events.LOG_COLUMNS`)
         The substep's contacts in the order they happened, as the engine logs them, in the
-        first ``count`` rows; those with a bounce factor of 0 (not corrected to first order)
-        are left out.
+        first ``count`` rows; the correction works in their last columns. One with a bounce
+        factor of 0 (not corrected to first order) starts its particles' errors afresh, and a
+        particle whose last contact it is is left alone.
     start_time, h : float
         The substep's start and length, s.
     start, position : ndarray, shape (N, 2)
@@ -86,22 +118,57 @@ def correct(
         squared softenings ``softenings2`` (L,), m^2.
     width, height, periodic
         The box's sides (m) and whether separations take the minimum image.
+    shadow : bool
+        Whether the pair forces are their laws' gradients, summed directly (the modified
+        energy's term needs it).
     """
+    shadow = shadow and couplings.shape[0] > 0
     for c in range(count):
-        bounce = contacts[c, LOG_BOUNCE]
-        if bounce == 0.0:
+        _carry(c, contacts, start_time, h, start, position, before, after, mass, sources,
+               couplings, softenings2, width, height, periodic)  # fmt: skip
+        contacts[c, LOG_DROP] = 0.0
+        if shadow and contacts[c, LOG_BOUNCE] != 0.0:
+            contacts[c, LOG_DROP] = _shadow_jump(
+                c, contacts, count, start_time, h, start, position, velocity, mass, sources,
+                couplings, softenings2, width, height, periodic,
+            )  # fmt: skip
+    for c in range(count):  # each particle's error at the end, from its last contact
+        if contacts[c, LOG_BOUNCE] == 0.0:
             continue
-        i = int(contacts[c, LOG_PARTICLE])
         partner = int(contacts[c, LOG_PARTNER])
-        tau = contacts[c, LOG_TIME] - start_time
-        nx, ny = contacts[c, LOG_NX], contacts[c, LOG_NY]
-        share = tau / h
-        if partner < 0:  # a mirror: C reflects the normal component
-            cx, cy = _at_contact(i, 0.0, 0.0, 0.0, 0.0, 0.0, share, before, after, mass, nx, ny)
-            px, py = (cx - before[i, 0]) * 0.5 * tau, (cy - before[i, 1]) * 0.5 * tau
-            along = bounce * (px * nx + py * ny) / (nx * nx + ny * ny)
-            _add(i, px - along * nx, py - along * ny, cx, cy, tau, h, before, after, velocity)
-            continue
+        rest = h - (contacts[c, LOG_TIME] - start_time)
+        for member in range(2 if partner >= 0 else 1):
+            k = int(contacts[c, LOG_PARTICLE]) if member == 0 else partner
+            if _meets_later(k, c, count, contacts):
+                continue
+            for d in range(2):
+                error = contacts[c, LOG_ERROR + 2 * member + d]
+                pull = contacts[c, LOG_PULL + 2 * member + d]
+                velocity[k, d] += (error + (0.5 * (pull + after[k, d]) - before[k, d]) * rest
+                                   + 0.5 * h * (before[k, d] - after[k, d]))  # fmt: skip
+    for c in range(count):
+        drop = contacts[c, LOG_DROP]
+        if drop != 0.0:
+            _take_along_normal(int(contacts[c, LOG_PARTICLE]), int(contacts[c, LOG_PARTNER]),
+                               drop, contacts[c, LOG_NX], contacts[c, LOG_NY], velocity,
+                               mass)  # fmt: skip
+
+
+@inlined
+def _carry(c, contacts, start_time, h, start, position, before, after, mass, sources, couplings,
+           softenings2, width, height, periodic) -> None:  # fmt: skip
+    """Carry the velocity errors of contact ``c``'s particles from their previous contacts (or
+    the substep's start) to it and through its map C, and log them with their accelerations
+    at the contact (``LOG_ERROR``, ``LOG_PULL``). An uncorrected contact (bounce factor 0)
+    starts its particles' errors afresh."""
+    i, partner = int(contacts[c, LOG_PARTICLE]), int(contacts[c, LOG_PARTNER])
+    tau = contacts[c, LOG_TIME] - start_time
+    nx, ny = contacts[c, LOG_NX], contacts[c, LOG_NY]
+    share = tau / h
+    if partner < 0:  # a mirror has no force of its own
+        ix, iy = _at_contact(i, 0.0, 0.0, 0.0, 0.0, 0.0, share, before, after, mass, nx, ny)
+        jx, jy = 0.0, 0.0
+    else:
         j = partner
         f0 = _mutual(i, j, start, sources, couplings, softenings2, width, height, periodic)
         fh = _mutual(i, j, position, sources, couplings, softenings2, width, height, periodic)
@@ -113,13 +180,290 @@ def correct(
                              mass, nx, ny)  # fmt: skip
         jx, jy = _at_contact(j, -f0 * s0x, -f0 * s0y, -fh * shx, -fh * shy, -fc, share, before,
                              after, mass, nx, ny)  # fmt: skip
-        pix, piy = (ix - before[i, 0]) * 0.5 * tau, (iy - before[i, 1]) * 0.5 * tau
-        pjx, pjy = (jx - before[j, 0]) * 0.5 * tau, (jy - before[j, 1]) * 0.5 * tau
-        along = bounce * ((pix - pjx) * nx + (piy - pjy) * ny) / (nx * nx + ny * ny)
+    eix, eiy = _error_at(i, c, tau, ix, iy, contacts, start_time, before)
+    ejx, ejy = 0.0, 0.0
+    if partner >= 0:
+        ejx, ejy = _error_at(partner, c, tau, jx, jy, contacts, start_time, before)
+    bounce = contacts[c, LOG_BOUNCE]
+    n2 = nx * nx + ny * ny
+    if bounce == 0.0:
+        eix, eiy, ejx, ejy = 0.0, 0.0, 0.0, 0.0
+    elif partner < 0:
+        along = bounce * (eix * nx + eiy * ny) / n2
+        eix, eiy = eix - along * nx, eiy - along * ny
+    else:
+        along = bounce * ((eix - ejx) * nx + (eiy - ejy) * ny) / n2
+        total = mass[i] + mass[partner]
+        gi, gj = along * mass[partner] / total, along * mass[i] / total
+        eix, eiy, ejx, ejy = eix - gi * nx, eiy - gi * ny, ejx + gj * nx, ejy + gj * ny
+    row = contacts[c]
+    row[LOG_ERROR], row[LOG_ERROR + 1], row[LOG_ERROR + 2], row[LOG_ERROR + 3] = eix, eiy, ejx, ejy
+    row[LOG_PULL], row[LOG_PULL + 1], row[LOG_PULL + 2], row[LOG_PULL + 3] = ix, iy, jx, jy
+
+
+@inlined
+def _error_at(k, c, tau, ax, ay, contacts, start_time, before) -> tuple[float, float]:
+    """Particle k's velocity error (m/s) just before contact ``c`` at ``tau`` s, where its
+    acceleration is (ax, ay): the error after its previous contact (none at the substep's
+    start), plus the impulse its acceleration, linear in between, gave beyond the kick's
+    constant ``a0``."""
+    ex, ey, t, px, py = 0.0, 0.0, 0.0, before[k, 0], before[k, 1]
+    for previous in range(c - 1, -1, -1):
+        p, q = int(contacts[previous, LOG_PARTICLE]), int(contacts[previous, LOG_PARTNER])
+        if k in (p, q):
+            row = contacts[previous]
+            slot = 0 if k == p else 2
+            ex, ey = row[LOG_ERROR + slot], row[LOG_ERROR + slot + 1]
+            px, py = row[LOG_PULL + slot], row[LOG_PULL + slot + 1]
+            t = row[LOG_TIME] - start_time
+            break
+    span = tau - t
+    return (ex + (0.5 * (px + ax) - before[k, 0]) * span,
+            ey + (0.5 * (py + ay) - before[k, 1]) * span)  # fmt: skip
+
+
+@inlined
+def _meets_later(k, c, count, contacts) -> bool:
+    """Whether particle k is in a contact logged after ``c``."""
+    for later in range(c + 1, count):
+        if k in (int(contacts[later, LOG_PARTICLE]), int(contacts[later, LOG_PARTNER])):
+            return True
+    return False
+
+
+@uncounted(error_model="numpy")
+def _shadow_jump(c, contacts, count, start_time, h, start, position, velocity, mass, sources,
+                 couplings, softenings2, width, height, periodic) -> float:  # fmt: skip
+    """The jump (J) that contact ``c`` of particle i (and its partner j, or -1 for a wall) makes
+    in the substep's modified energy (module docstring): from the change ``dQ`` of
+    ``Q = sum_pairs w . Hess(U) . w`` by the contact's velocity changes ``dv``, and the others'
+    pull's curvature along them, ``dv . Hess . dv``, at the contact: the velocities there are the
+    ones after the drift less the later contacts' changes, the positions those interpolated over
+    the substep, put back on their paths for the particles that met contacts (the pair's
+    separation is the logged normal)."""
+    row = contacts[c]
+    i, j = int(row[LOG_PARTICLE]), max(int(row[LOG_PARTNER]), -1)
+    tau = row[LOG_TIME] - start_time
+    dix, diy = row[LOG_DVX], row[LOG_DVY]
+    djx, djy = 0.0, 0.0
+    if j >= 0:
+        djx, djy = -dix * mass[i] / mass[j], -diy * mass[i] / mass[j]
+    change, bend = 0.0, 0.0
+    for one in range(2 if j >= 0 else 1):
+        a = i if one == 0 else j
+        dx, dy = (dix, diy) if one == 0 else (djx, djy)
+        vx, vy = _after_contact(a, c, count, contacts, velocity, mass)
+        # Halfway through the change, where a quadratic form's difference is exact.
+        wx, wy = vx - 0.5 * dx, vy - 0.5 * dy
+        ax, ay = _on_path(a, tau, count, contacts, start_time, h, start, position, mass, width,
+                          height, periodic)  # fmt: skip
+        for k in range(position.shape[0]):
+            if k in (i, j):
+                continue
+            kx, ky = _at_share(k, tau / h, start, position, width, height, periodic)
+            dc, db = _terms(a, k, ax - kx, ay - ky, dx, dy, wx - velocity[k, 0],
+                            wy - velocity[k, 1], sources, couplings, softenings2, width, height,
+                            periodic)  # fmt: skip
+            change, bend = change + dc, bend + db
+        # The others that met contacts: their terms again, at their places and velocities then.
+        for other in range(count):
+            p, q = int(contacts[other, LOG_PARTICLE]), int(contacts[other, LOG_PARTNER])
+            for member in range(2 if q >= 0 else 1):
+                k = p if member == 0 else q
+                if k in (i, j) or _met_before(k, other, contacts):
+                    continue
+                kx, ky = _at_share(k, tau / h, start, position, width, height, periodic)
+                dc, db = _terms(a, k, ax - kx, ay - ky, dx, dy, wx - velocity[k, 0],
+                                wy - velocity[k, 1], sources, couplings, softenings2, width,
+                                height, periodic)  # fmt: skip
+                change, bend = change - dc, bend - db
+                kx, ky = _on_path(k, tau, count, contacts, start_time, h, start, position, mass,
+                                  width, height, periodic)  # fmt: skip
+                ux, uy = _after_contact(k, c, count, contacts, velocity, mass)
+                dc, db = _terms(a, k, ax - kx, ay - ky, dx, dy, wx - ux, wy - uy, sources,
+                                couplings, softenings2, width, height, periodic)  # fmt: skip
+                change, bend = change + dc, bend + db
+    if j >= 0:
+        vix, viy = _after_contact(i, c, count, contacts, velocity, mass)
+        vjx, vjy = _after_contact(j, c, count, contacts, velocity, mass)
+        wx, wy = vix - 0.5 * dix - vjx + 0.5 * djx, viy - 0.5 * diy - vjy + 0.5 * djy
+        change += 2.0 * _hessian_form(i, j, row[LOG_NX], row[LOG_NY], dix - djx, diy - djy, wx,
+                                      wy, sources, couplings, softenings2)  # fmt: skip
+    jump = (h * h - 3.0 * tau * (h - tau)) / 12.0 * change
+    jump -= tau * (h - tau) * (h - 2.0 * tau) / (4.0 * h) * bend
+    for other in range(c):  # with each earlier contact, its changes against this one's
+        if contacts[other, LOG_BOUNCE] != 0.0:
+            t = contacts[other, LOG_TIME] - start_time
+            form = _cross_form(c, other, tau, count, contacts, start_time, h, start, position,
+                               mass, sources, couplings, softenings2, width, height,
+                               periodic)  # fmt: skip
+            jump += t * (h - tau) * (tau + t - h) / (2.0 * h) * form
+    return jump
+
+
+@inlined
+def _cross_form(c, other, tau, count, contacts, start_time, h, start, position, mass, sources,
+                couplings, softenings2, width, height, periodic) -> float:  # fmt: skip
+    """``dv_c . Hess(U) . dv_other`` (J/s^2): the Hessian of every pair law between the
+    velocity changes of contacts ``c`` and ``other``, at the positions ``tau`` s into the
+    substep: over the pairs among their particles, and a particle in both with every other."""
+    ids = (
+        int(contacts[c, LOG_PARTICLE]),
+        int(contacts[c, LOG_PARTNER]),
+        int(contacts[other, LOG_PARTICLE]),
+        int(contacts[other, LOG_PARTNER]),
+    )
+    form = 0.0
+    for x in range(4):
+        a = ids[x]
+        if a < 0 or _listed(a, ids, x):
+            continue
+        ax, ay = _on_path(a, tau, count, contacts, start_time, h, start, position, mass, width,
+                          height, periodic)  # fmt: skip
+        ux, uy = _change_of(a, c, contacts, mass)
+        wx, wy = _change_of(a, other, contacts, mass)
+        for y in range(x + 1, 4):
+            b = ids[y]
+            if b < 0 or b == a or _listed(b, ids, y):
+                continue
+            bx, by = _on_path(b, tau, count, contacts, start_time, h, start, position, mass,
+                              width, height, periodic)  # fmt: skip
+            vx, vy = _change_of(b, c, contacts, mass)
+            zx, zy = _change_of(b, other, contacts, mass)
+            sx, sy = _image(ax - bx, ay - by, width, height, periodic)
+            form += _hessian_form(a, b, sx, sy, ux - vx, uy - vy, wx - zx, wy - zy, sources,
+                                  couplings, softenings2)  # fmt: skip
+        if (ux == 0.0 and uy == 0.0) or (wx == 0.0 and wy == 0.0):
+            continue
+        for k in range(position.shape[0]):  # a is in both: its pairs with the rest
+            if k in ids:
+                continue
+            kx, ky = _at_share(k, tau / h, start, position, width, height, periodic)
+            sx, sy = _image(ax - kx, ay - ky, width, height, periodic)
+            form += _hessian_form(a, k, sx, sy, ux, uy, wx, wy, sources, couplings, softenings2)
+    return form
+
+
+@inlined
+def _listed(a, ids, before) -> bool:
+    """Whether ``a`` is among the first ``before`` of ``ids``."""
+    for x in range(before):  # noqa: SIM110 (numba compiles no generator)
+        if ids[x] == a:
+            return True
+    return False
+
+
+@inlined
+def _terms(a, k, sx, sy, dx, dy, wx, wy, sources, couplings, softenings2, width, height,
+           periodic) -> tuple[float, float]:  # fmt: skip
+    """Pair (a, k)'s part of ``dQ``, ``2 d . Hess . w``, and of the curvature, ``d . Hess . d``
+    (J/s^2), at separation ``s`` (m, its minimum image taken here)."""
+    sx, sy = _image(sx, sy, width, height, periodic)
+    return (
+        2.0 * _hessian_form(a, k, sx, sy, dx, dy, wx, wy, sources, couplings, softenings2),
+        _hessian_form(a, k, sx, sy, dx, dy, dx, dy, sources, couplings, softenings2),
+    )
+
+
+@inlined
+def _met_before(k, row, contacts) -> bool:
+    """Whether particle k is in a contact logged before ``row``."""
+    for earlier in range(row):
+        if k in (int(contacts[earlier, LOG_PARTICLE]), int(contacts[earlier, LOG_PARTNER])):
+            return True
+    return False
+
+
+@inlined
+def _change_of(a, row, contacts, mass) -> tuple[float, float]:
+    """The change of particle a's velocity (m/s) at contact ``row``: 0 if it is not in it."""
+    p, q = int(contacts[row, LOG_PARTICLE]), int(contacts[row, LOG_PARTNER])
+    scale = 1.0 if p == a else (-mass[p] / mass[a] if q == a else 0.0)
+    return scale * contacts[row, LOG_DVX], scale * contacts[row, LOG_DVY]
+
+
+@inlined
+def _after_contact(a, c, count, contacts, velocity, mass) -> tuple[float, float]:
+    """Particle a's velocity just after contact ``c`` (m/s): its ``velocity`` less the changes
+    of the contacts logged after ``c``."""
+    vx, vy = velocity[a, 0], velocity[a, 1]
+    for later in range(c + 1, count):
+        dx, dy = _change_of(a, later, contacts, mass)
+        vx, vy = vx - dx, vy - dy
+    return vx, vy
+
+
+@inlined
+def _on_path(a, tau, count, contacts, start_time, h, start, position, mass, width, height,
+             periodic) -> tuple[float, float]:  # fmt: skip
+    """Particle a's position ``tau`` s into the substep (m): the straight interpolation
+    (`_at_share`) put back on its path, bent at each of its contacts."""
+    x, y = _at_share(a, tau / h, start, position, width, height, periodic)
+    for row in range(count):
+        dx, dy = _change_of(a, row, contacts, mass)
+        t = contacts[row, LOG_TIME] - start_time
+        lead = max(tau - t, 0.0) - tau / h * (h - t)
+        x, y = x + dx * lead, y + dy * lead
+    return x, y
+
+
+@inlined
+def _hessian_form(a, b, sx, sy, dx, dy, wx, wy, sources, couplings, softenings2) -> float:
+    """``d . Hess(U_ab) . w`` of the pair laws at separation ``s`` (m): ``d``, ``w`` in m/s,
+    the result in J/s^2."""
+    total = 0.0
+    for law in range(couplings.shape[0]):
+        kqq = couplings[law] * sources[law, a] * sources[law, b]
+        if kqq != 0.0:
+            u = sx * sx + sy * sy + softenings2[law]
+            along = 3.0 * (dx * sx + dy * sy) * (wx * sx + wy * sy) / u
+            total += kqq / (u * math.sqrt(u)) * (along - dx * wx - dy * wy)
+    return total
+
+
+@inlined
+def _take_along_normal(i, j, drop, nx, ny, velocity, mass) -> None:
+    """Take ``drop`` (J) from the kinetic energy of the contact's normal motion, the pair's
+    relative one (momentum kept) or a wall's particle's, where there is that much."""
+    norm = math.sqrt(nx * nx + ny * ny)
+    ux, uy = nx / norm, ny / norm
+    if j >= 0:
+        reduced = mass[i] * mass[j] / (mass[i] + mass[j])
+        normal = (velocity[i, 0] - velocity[j, 0]) * ux + (velocity[i, 1] - velocity[j, 1]) * uy
+    else:
+        reduced = mass[i]
+        normal = velocity[i, 0] * ux + velocity[i, 1] * uy
+    left = normal * normal - 2.0 * drop / reduced
+    if not left > 0.0:
+        return
+    change = math.copysign(math.sqrt(left), normal) - normal
+    if j >= 0:
         total = mass[i] + mass[j]
-        gi, gj = along * mass[j] / total, along * mass[i] / total
-        _add(i, pix - gi * nx, piy - gi * ny, ix, iy, tau, h, before, after, velocity)
-        _add(j, pjx + gj * nx, pjy + gj * ny, jx, jy, tau, h, before, after, velocity)
+        velocity[i, 0] += change * mass[j] / total * ux
+        velocity[i, 1] += change * mass[j] / total * uy
+        velocity[j, 0] -= change * mass[i] / total * ux
+        velocity[j, 1] -= change * mass[i] / total * uy
+    else:
+        velocity[i, 0] += change * ux
+        velocity[i, 1] += change * uy
+
+
+@inlined
+def _at_share(k, share, start, position, width, height, periodic) -> tuple[float, float]:
+    """Particle k's position ``share`` of the way through the substep (m), straight from its
+    start to its end (the minimum image of the way when ``periodic``)."""
+    dx, dy = _image(position[k, 0] - start[k, 0], position[k, 1] - start[k, 1], width, height,
+                    periodic)  # fmt: skip
+    return start[k, 0] + share * dx, start[k, 1] + share * dy
+
+
+@inlined
+def _image(sx, sy, width, height, periodic) -> tuple[float, float]:
+    """The minimum image of a separation (m) when ``periodic``."""
+    if periodic:
+        sx -= width * round(sx / width)
+        sy -= height * round(sy / height)
+    return sx, sy
 
 
 @numba.njit(cache=True, inline="always")
@@ -134,24 +478,10 @@ def _at_contact(i, f0x, f0y, fhx, fhy, fc, share, before, after, mass, nx, ny):
 
 
 @numba.njit(cache=True, inline="always")
-def _add(i, cx, cy, ax, ay, tau, h, before, after, velocity) -> None:
-    """Add ``X`` to particle i's velocity: ``C[P]`` (cx, cy), then the accelerations' terms,
-    ``a`` (ax, ay) at the contact."""
-    for d in range(2):
-        at = ax if d == 0 else ay
-        velocity[i, d] += ((cx if d == 0 else cy) + at * 0.5 * (h - tau)
-                           - after[i, d] * 0.5 * tau + before[i, d] * (tau - 0.5 * h))  # fmt: skip
-
-
-@numba.njit(cache=True, inline="always")
 def _separation(i, j, position, width, height, periodic) -> tuple[float, float]:
     """``x_i - x_j`` (m), the minimum image when ``periodic``."""
-    sx = position[i, 0] - position[j, 0]
-    sy = position[i, 1] - position[j, 1]
-    if periodic:
-        sx -= width * round(sx / width)
-        sy -= height * round(sy / height)
-    return sx, sy
+    return _image(position[i, 0] - position[j, 0], position[i, 1] - position[j, 1], width, height,
+                  periodic)  # fmt: skip
 
 
 @numba.njit(cache=True, inline="always")

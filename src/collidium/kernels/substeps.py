@@ -363,7 +363,8 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
             return s, t, fastest, given, processed, drifts
         if meets:
             kick_timing.correct(log, logged[0], t, h, position, flown, acceleration, pull,
-                                kicked, mass, law[0], law[1], law[2], 0.0, 0.0, False)  # fmt: skip
+                                kicked, mass, law[0], law[1], law[2], 0.0, 0.0, False,
+                                True)  # fmt: skip
             processed += done
             drifts += 1
         after = 0.0
