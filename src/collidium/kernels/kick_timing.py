@@ -236,11 +236,9 @@ def _shadow_jump(c, contacts, count, start_time, h, start, position, velocity, m
                  couplings, softenings2, width, height, periodic) -> float:  # fmt: skip
     """The jump (J) that contact ``c`` of particle i (and its partner j, or -1 for a wall) makes
     in the substep's modified energy (module docstring): from the change ``dQ`` of
-    ``Q = sum_pairs w . Hess(U) . w`` by the contact's velocity changes ``dv``, and the others'
-    pull's curvature along them, ``dv . Hess . dv``, at the contact: the velocities there are the
-    ones after the drift less the later contacts' changes, the positions those interpolated over
-    the substep, put back on their paths for the particles that met contacts (the pair's
-    separation is the logged normal)."""
+    ``Q = sum_pairs w . Hess(U) . w`` by the contact's velocity changes ``dv`` and the others'
+    pull's curvature along them, ``dv . Hess . dv``, at the contact (`_member_terms`; the pair's
+    own separation is the logged normal), and the cross terms with the earlier contacts."""
     row = contacts[c]
     i, j = int(row[LOG_PARTICLE]), max(int(row[LOG_PARTNER]), -1)
     tau = row[LOG_TIME] - start_time
@@ -252,37 +250,10 @@ def _shadow_jump(c, contacts, count, start_time, h, start, position, velocity, m
     for one in range(2 if j >= 0 else 1):
         a = i if one == 0 else j
         dx, dy = (dix, diy) if one == 0 else (djx, djy)
-        vx, vy = _after_contact(a, c, count, contacts, velocity, mass)
-        # Halfway through the change, where a quadratic form's difference is exact.
-        wx, wy = vx - 0.5 * dx, vy - 0.5 * dy
-        ax, ay = _on_path(a, tau, count, contacts, start_time, h, start, position, mass, width,
-                          height, periodic)  # fmt: skip
-        for k in range(position.shape[0]):
-            if k in (i, j):
-                continue
-            kx, ky = _at_share(k, tau / h, start, position, width, height, periodic)
-            dc, db = _terms(a, k, ax - kx, ay - ky, dx, dy, wx - velocity[k, 0],
-                            wy - velocity[k, 1], sources, couplings, softenings2, width, height,
-                            periodic)  # fmt: skip
-            change, bend = change + dc, bend + db
-        # The others that met contacts: their terms again, at their places and velocities then.
-        for other in range(count):
-            p, q = int(contacts[other, LOG_PARTICLE]), int(contacts[other, LOG_PARTNER])
-            for member in range(2 if q >= 0 else 1):
-                k = p if member == 0 else q
-                if k in (i, j) or _met_before(k, other, contacts):
-                    continue
-                kx, ky = _at_share(k, tau / h, start, position, width, height, periodic)
-                dc, db = _terms(a, k, ax - kx, ay - ky, dx, dy, wx - velocity[k, 0],
-                                wy - velocity[k, 1], sources, couplings, softenings2, width,
-                                height, periodic)  # fmt: skip
-                change, bend = change - dc, bend - db
-                kx, ky = _on_path(k, tau, count, contacts, start_time, h, start, position, mass,
-                                  width, height, periodic)  # fmt: skip
-                ux, uy = _after_contact(k, c, count, contacts, velocity, mass)
-                dc, db = _terms(a, k, ax - kx, ay - ky, dx, dy, wx - ux, wy - uy, sources,
-                                couplings, softenings2, width, height, periodic)  # fmt: skip
-                change, bend = change + dc, bend + db
+        dc, db = _member_terms(a, dx, dy, c, i, j, tau, count, contacts, start_time, h, start,
+                               position, velocity, mass, sources, couplings, softenings2, width,
+                               height, periodic)  # fmt: skip
+        change, bend = change + dc, bend + db
     if j >= 0:
         vix, viy = _after_contact(i, c, count, contacts, velocity, mass)
         vjx, vjy = _after_contact(j, c, count, contacts, velocity, mass)
@@ -299,6 +270,49 @@ def _shadow_jump(c, contacts, count, start_time, h, start, position, velocity, m
                                periodic)  # fmt: skip
             jump += t * (h - tau) * (tau + t - h) / (2.0 * h) * form
     return jump
+
+
+@uncounted(error_model="numpy")
+def _member_terms(a, dx, dy, c, i, j, tau, count, contacts, start_time, h, start, position,
+                  velocity, mass, sources, couplings, softenings2, width, height,
+                  periodic) -> tuple[float, float]:  # fmt: skip
+    """Member a's pairs with every particle outside contact ``c`` (i, j): their parts of ``dQ``
+    and of the curvature (`_terms`) for a's velocity change ``d`` (m/s), at the contact. The
+    velocities there are the ones after the drift less the later contacts' changes, the
+    positions those interpolated over the substep, put back on their paths for the particles
+    that met contacts."""
+    vx, vy = _after_contact(a, c, count, contacts, velocity, mass)
+    # Halfway through the change, where a quadratic form's difference is exact.
+    wx, wy = vx - 0.5 * dx, vy - 0.5 * dy
+    ax, ay = _on_path(a, tau, count, contacts, start_time, h, start, position, mass, width,
+                      height, periodic)  # fmt: skip
+    change, bend = 0.0, 0.0
+    for k in range(position.shape[0]):
+        if k in (i, j):
+            continue
+        kx, ky = _at_share(k, tau / h, start, position, width, height, periodic)
+        dc, db = _terms(a, k, ax - kx, ay - ky, dx, dy, wx - velocity[k, 0], wy - velocity[k, 1],
+                        sources, couplings, softenings2, width, height, periodic)  # fmt: skip
+        change, bend = change + dc, bend + db
+    # The others that met contacts: their terms again, at their places and velocities then.
+    for other in range(count):
+        p, q = int(contacts[other, LOG_PARTICLE]), int(contacts[other, LOG_PARTNER])
+        for member in range(2 if q >= 0 else 1):
+            k = p if member == 0 else q
+            if k in (i, j) or _met_before(k, other, contacts):
+                continue
+            kx, ky = _at_share(k, tau / h, start, position, width, height, periodic)
+            dc, db = _terms(a, k, ax - kx, ay - ky, dx, dy, wx - velocity[k, 0],
+                            wy - velocity[k, 1], sources, couplings, softenings2, width, height,
+                            periodic)  # fmt: skip
+            change, bend = change - dc, bend - db
+            kx, ky = _on_path(k, tau, count, contacts, start_time, h, start, position, mass,
+                              width, height, periodic)  # fmt: skip
+            ux, uy = _after_contact(k, c, count, contacts, velocity, mass)
+            dc, db = _terms(a, k, ax - kx, ay - ky, dx, dy, wx - ux, wy - uy, sources, couplings,
+                            softenings2, width, height, periodic)  # fmt: skip
+            change, bend = change + dc, bend + db
+    return change, bend
 
 
 @inlined
