@@ -42,7 +42,8 @@ the energy's drift, the substeps between contacts keeping S to 1e-10 of the ener
 relative one, momentum kept), so that S goes through it to O(h^3); a single contact's jump
 then falls eightfold per halving of h, not fourfold. Only where the pair forces are summed as
 their laws' gradients (directly, uncapped; `collidium.forces.base.PairLawForce.follows_law`):
-a tree's or a limiter's forces have no such S.
+a tree's or a limiter's forces have no such S. The Hessians are the pair laws'; a uniform field
+has none, and a field map's is left out.
 
 The positions after the contact, drifted with the first-order velocities, are off by O(h^3).
 """
