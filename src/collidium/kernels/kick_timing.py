@@ -140,7 +140,7 @@ def correct(
         rest = h - (contacts[c, LOG_TIME] - start_time)
         for member in range(2 if partner >= 0 else 1):
             k = int(contacts[c, LOG_PARTICLE]) if member == 0 else partner
-            if _meets_later(k, c, count, contacts):
+            if _in_rows(k, c + 1, count, contacts):
                 continue
             for d in range(2):
                 error = contacts[c, LOG_ERROR + 2 * member + d]
@@ -224,10 +224,10 @@ def _error_at(k, c, tau, ax, ay, contacts, start_time, before) -> tuple[float, f
 
 
 @inlined
-def _meets_later(k, c, count, contacts) -> bool:
-    """Whether particle k is in a contact logged after ``c``."""
-    for later in range(c + 1, count):
-        if k in (int(contacts[later, LOG_PARTICLE]), int(contacts[later, LOG_PARTNER])):
+def _in_rows(k, first, stop, contacts) -> bool:
+    """Whether particle k is in one of the contacts logged in rows ``first`` to ``stop - 1``."""
+    for row in range(first, stop):
+        if k in (int(contacts[row, LOG_PARTICLE]), int(contacts[row, LOG_PARTNER])):
             return True
     return False
 
@@ -300,7 +300,7 @@ def _member_terms(a, dx, dy, c, i, j, tau, count, contacts, start_time, h, start
         p, q = int(contacts[other, LOG_PARTICLE]), int(contacts[other, LOG_PARTNER])
         for member in range(2 if q >= 0 else 1):
             k = p if member == 0 else q
-            if k in (i, j) or _met_before(k, other, contacts):
+            if k in (i, j) or _in_rows(k, 0, other, contacts):
                 continue
             kx, ky = _at_share(k, tau / h, start, position, width, height, periodic)
             dc, db = _terms(a, k, ax - kx, ay - ky, dx, dy, wx - velocity[k, 0],
@@ -374,19 +374,8 @@ def _terms(a, k, sx, sy, dx, dy, wx, wy, sources, couplings, softenings2, width,
     """Pair (a, k)'s part of ``dQ``, ``2 d . Hess . w``, and of the curvature, ``d . Hess . d``
     (J/s^2), at separation ``s`` (m, its minimum image taken here)."""
     sx, sy = _image(sx, sy, width, height, periodic)
-    return (
-        2.0 * _hessian_form(a, k, sx, sy, dx, dy, wx, wy, sources, couplings, softenings2),
-        _hessian_form(a, k, sx, sy, dx, dy, dx, dy, sources, couplings, softenings2),
-    )
-
-
-@inlined
-def _met_before(k, row, contacts) -> bool:
-    """Whether particle k is in a contact logged before ``row``."""
-    for earlier in range(row):
-        if k in (int(contacts[earlier, LOG_PARTICLE]), int(contacts[earlier, LOG_PARTNER])):
-            return True
-    return False
+    form, bend = _hessian_forms(a, k, sx, sy, dx, dy, wx, wy, sources, couplings, softenings2)
+    return 2.0 * form, bend
 
 
 @inlined
@@ -426,14 +415,23 @@ def _on_path(a, tau, count, contacts, start_time, h, start, position, mass, widt
 def _hessian_form(a, b, sx, sy, dx, dy, wx, wy, sources, couplings, softenings2) -> float:
     """``d . Hess(U_ab) . w`` of the pair laws at separation ``s`` (m): ``d``, ``w`` in m/s,
     the result in J/s^2."""
-    total = 0.0
+    return _hessian_forms(a, b, sx, sy, dx, dy, wx, wy, sources, couplings, softenings2)[0]
+
+
+@inlined
+def _hessian_forms(a, b, sx, sy, dx, dy, wx, wy, sources, couplings, softenings2):
+    """``(d . Hess(U_ab) . w, d . Hess(U_ab) . d)`` (J/s^2) of the pair laws at separation ``s``
+    (m), in one pass over the laws: ``d``, ``w`` in m/s."""
+    form, bend = 0.0, 0.0
     for law in range(couplings.shape[0]):
         kqq = couplings[law] * sources[law, a] * sources[law, b]
         if kqq != 0.0:
             u = sx * sx + sy * sy + softenings2[law]
-            along = 3.0 * (dx * sx + dy * sy) * (wx * sx + wy * sy) / u
-            total += kqq / (u * math.sqrt(u)) * (along - dx * wx - dy * wy)
-    return total
+            scale = kqq / (u * math.sqrt(u))
+            along = 3.0 * (dx * sx + dy * sy) / u
+            form += scale * (along * (wx * sx + wy * sy) - dx * wx - dy * wy)
+            bend += scale * (along * (dx * sx + dy * sy) - dx * dx - dy * dy)
+    return form, bend
 
 
 @inlined
