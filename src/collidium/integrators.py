@@ -55,8 +55,10 @@ DEFAULT_TOLERANCE = 0.0007
 #: Most regular substeps in one reporting interval (a power of two). An interval that needs more
 #: at its start stops the run with one line (the forces are too strong for this dt, and it would
 #: take minutes); one that finds out only as it goes is taken with this many, and the energy
-#: check of the run reports the error.
-MAX_SUBSTEPS = 2**14
+#: check of the run reports the error. The seed's point charges passing through each other
+#: (charged-no-collisions) take up to 2^14 substeps a dt at the default tolerance: sixteen times
+#: that leaves room for a tolerance eight times finer, twice over.
+MAX_SUBSTEPS = 2**18
 
 #: The energy scale of the substep criterion is the total energy, but at least ``KE + |U|``
 #: divided by this.
@@ -330,7 +332,8 @@ class AdaptiveLeapfrog(Integrator):
         if not dt * math.sqrt(rate2) <= MAX_SUBSTEPS * self.tolerance:  # also NaN
             raise SimulationError(
                 f"the forces need more than {MAX_SUBSTEPS} substeps in one dt = {dt:g} s at "
-                f"t = {now:.6g} s: they are too strong for this dt; try a smaller dt or softening"
+                f"t = {now:.6g} s: they are too strong for this dt; try a smaller dt, a larger "
+                "softening or a larger tolerance"
             )
         n = max(self.substeps, self.needed(rate2, dt))
         while True:
