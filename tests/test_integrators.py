@@ -111,6 +111,18 @@ def test_contacts_keep_the_modified_energy_of_the_substeps_between_them(monkeypa
     assert rms(kept[met]) < rms(plain[met_plain]) / 4
 
 
+def test_a_change_of_substep_keeps_the_modified_energy():
+    """Two opposite charges fall together and collide again and again, the substeps shortening
+    for each close approach and lengthening after it: with the modified energy kept at each
+    change (`collidium.kernels.modified_energy`) the energy errs nine times less over 10 s than
+    with the jumps left (3.4e-7 against 3.0e-6)."""
+    kept = max_drift(cd.load("charged-opposite"), 10.0)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(ForceField, "keeps_modified_energy", lambda *arguments: False)
+        left = max_drift(cd.load("charged-opposite"), 10.0)
+    assert left > 5.0 * kept
+
+
 def test_a_periodic_charged_gas_holds_its_energy():
     fixed = cd.load("charged-gas", boundary="periodic", n=100, integrator="fixed")
     adaptive = cd.load("charged-gas", boundary="periodic", n=100)
@@ -200,6 +212,8 @@ def test_checkpoint_resumes_bitwise(tmp_path, name, time):
     part.save(tmp_path / "run.ckpt")
     resumed = cd.restore(tmp_path / "run.ckpt")
     assert resumed.integrator == "adaptive" and resumed.tolerance == DEFAULT_TOLERANCE
+    # The last interval's substep, from which the next keeps the modified energy.
+    assert resumed._integrator.substep == part._integrator.substep > 0.0
     resumed.run(time=0.5 * time)
     np.testing.assert_array_equal(resumed.particles.position, whole.particles.position)
     np.testing.assert_array_equal(resumed.particles.velocity, whole.particles.velocity)

@@ -39,7 +39,7 @@ from collidium.collisions import (
 from collidium.errors import SimulationError
 from collidium.forces import ForceField
 from collidium.forces.base import CompiledForces
-from collidium.kernels import kick_timing, substeps, sums
+from collidium.kernels import kick_timing, modified_energy, substeps, sums
 from collidium.kernels.pairwise import PARALLEL_DIRECT_FROM
 from collidium.state import FloatArray, Particles, writable
 from collidium.vessels import Vessel
@@ -50,7 +50,7 @@ INTEGRATORS: tuple[IntegratorName, ...] = ("adaptive", "fixed")
 #: The adaptive integrator's default accuracy parameter: the largest substep as a fraction of the
 #: fastest pair time scale. It keeps every seed scene's energy error within the documented
 #: targets at dt = 0.01 s (README); the energy error scales as its square.
-DEFAULT_TOLERANCE = 0.0007
+DEFAULT_TOLERANCE = 0.002
 
 #: Most regular substeps in one reporting interval (a power of two). An interval that needs more
 #: at its start stops the run with one line (the forces are too strong for this dt, and it would
@@ -242,6 +242,10 @@ class AdaptiveLeapfrog(Integrator):
     is sized from its start alone, which makes adaptive leapfrog drift: the scheme is
     time-symmetric within an interval, and the count of an interval depends on its neighbours
     only by that factor of two. The energy error stays bounded and scales as ``tolerance^2``.
+    Where the substep changes from one interval to the next, the velocities are scaled so that
+    the substeps' modified energy goes on (`collidium.kernels.modified_energy`; where the
+    forces have one, `ForceField.keeps_modified_energy`): left, each change would leave its
+    jump in the energy.
 
     A contact under a force (a collision or a wall hit of a particle with an acceleration) falls
     inside a drift, between the kicks, which put the forces' impulse at the substep's ends. The
@@ -273,6 +277,8 @@ class AdaptiveLeapfrog(Integrator):
         super().__init__(tolerance)
         #: Regular substeps the next interval starts with (it may take more).
         self.substeps = 1
+        #: The last interval's substep, s (NaN before the first).
+        self.substep = math.nan
         self._flight: _SmoothFlight | None = None
         #: Whether `step` takes the next interval in Python at once, not tried whole: the last
         #: met a contact under forces (in a gas the next likely meets one too, and a try would
@@ -284,18 +290,21 @@ class AdaptiveLeapfrog(Integrator):
         self._one: FlightRecord | None = None
 
     def state(self) -> dict[str, np.ndarray]:
-        """The substep count the next interval starts with, and whether it is taken in Python
-        at once."""
+        """The substep count the next interval starts with, whether it is taken in Python at
+        once, and the last interval's substep."""
         return {
             "substeps": np.array([self.substeps], dtype=np.int64),
             "next_in_python": np.array([self.next_in_python]),
+            "substep": np.array([self.substep]),
         }
 
     def load_state(self, arrays: dict[str, np.ndarray]) -> None:
-        """Take back what `state` returned (a missing count starts at 1)."""
+        """Take back what `state` returned (a missing count starts at 1, a missing substep is
+        none)."""
         self.substeps = int(arrays["substeps"][0]) if "substeps" in arrays else 1
         python = arrays.get("next_in_python")
         self.next_in_python = False if python is None else bool(python[0])
+        self.substep = float(arrays["substep"][0]) if "substep" in arrays else math.nan
 
     def needed(self, rate2: float, dt: float) -> int:
         """The fewest substeps, a power of two up to `MAX_SUBSTEPS`, that keep ``dt / n`` within
@@ -336,7 +345,11 @@ class AdaptiveLeapfrog(Integrator):
                 "softening or a larger tolerance"
             )
         n = max(self.substeps, self.needed(rate2, dt))
+        keep = field.keeps_modified_energy(particles, vessel)
         while True:
+            if keep and dt / n != self.substep:  # NaN: none before
+                _keep_modified_energy(particles, vessel, field, self.substep, dt / n,
+                                      self.tolerance)  # fmt: skip
             try:
                 fastest, self.next_in_python = self._interval(
                     particles, vessel, field, drift, flight, now, dt, tally, n, rate2, total
@@ -352,6 +365,7 @@ class AdaptiveLeapfrog(Integrator):
             field.restore(evaluated)
             n = max(required, 2 * n)
         self.substeps = max(1, n // 2) if required <= n // 2 else n
+        self.substep = dt / n
 
     def _one_record(self, tally: Tally) -> FlightRecord:
         """The record of one interval, kept while the tally's size stays the same."""
@@ -404,9 +418,10 @@ class AdaptiveLeapfrog(Integrator):
                    record: FlightRecord) -> int:  # fmt: skip
         """`_SmoothFlight.intervals` from the substep count kept, which it updates, and the
         energy the drag gave, which it adds to the ``tally``."""
-        flown, self.substeps = flight.intervals(
-            particles, field, origin, elapsed, dt, self.substeps, self.tolerance, tally, record
-        )
+        flown, self.substeps, self.substep = flight.intervals(
+            particles, field, origin, elapsed, dt, self.substeps, self.substep, self.tolerance,
+            tally, record,
+        )  # fmt: skip
         if flown:
             tally.forces[0] = record.forces[flown - 1]
         return flown
@@ -507,6 +522,21 @@ def _corrected(
         log.rows, int(log.count[0]), t, h, start, particles.position, before, after,
         particles.velocity, writable(particles.mass), *field.pair_laws(particles), width, height,
         vessel.periodic, field.follows_laws(particles, vessel),
+    )  # fmt: skip
+
+
+def _keep_modified_energy(particles: Particles, vessel: Vessel, field: ForceField,
+                          substep: float, following: float, limit: float) -> None:  # fmt: skip
+    """Keep the substeps' modified energy from substeps of ``substep`` to ``following`` (s;
+    nothing if ``substep`` is NaN), the velocities scaled by at most ``limit``
+    (`collidium.kernels.modified_energy.keep_across_step`)."""
+    if math.isnan(substep):
+        return
+    width, height = (float(side) for side in vessel.size)
+    modified_energy.keep_across_step(
+        particles.position, particles.velocity, field.acceleration, writable(particles.mass),
+        *field.pair_laws(particles), width, height, vessel.periodic, np.empty((4, particles.n)),
+        substep, following, limit,
     )  # fmt: skip
 
 
@@ -645,25 +675,28 @@ class _SmoothFlight:
         elapsed: int,
         dt: float,
         starting: int,
+        substep: float,
         tolerance: float,
         tally: Tally,
         record: FlightRecord,
-    ) -> tuple[int, int]:
+    ) -> tuple[int, int, float]:
         """Whole intervals, up to ``len(record.values)``, the first taken with ``starting``
-        substeps or more (`collidium.kernels.substeps.smooth_intervals`), up to one that meets
-        a contact left to Python: ``(intervals taken, the substep count the next starts
-        from)``. The ``record`` gets the energies and the tallies at each one's end, its
-        ``forces`` the energy the velocity forces have given, from the ``tally``'s. The field's
-        acceleration is kept current."""
-        flown, after, processed, drifts = substeps.smooth_intervals(
+        substeps or more (`collidium.kernels.substeps.smooth_intervals`), after one of
+        ``substep`` s (NaN for none), up to one that meets a contact left to Python:
+        ``(intervals taken, the substep count the next starts from, the last one's substep)``.
+        The ``record`` gets the energies and the tallies at each one's end, its ``forces`` the
+        energy the velocity forces have given, from the ``tally``'s. The field's acceleration is
+        kept current."""
+        keep = field.keeps_modified_energy(particles, self.vessel)
+        flown, after, last, processed, drifts = substeps.smooth_intervals(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
             *self._forces, *self.walls, origin, elapsed, dt, record.values.shape[0], starting,
-            tolerance, MAX_SUBSTEPS, TOTAL_ENERGY_FLOOR, float(tally.forces[0]), record.values,
-            record.forces, self._contacts(particles, tally), record.counts, record.impulse,
-            record.heat,
+            substep, keep, tolerance, MAX_SUBSTEPS, TOTAL_ENERGY_FLOOR, float(tally.forces[0]),
+            record.values, record.forces, self._contacts(particles, tally), record.counts,
+            record.impulse, record.heat,
         )  # fmt: skip
         self._took(processed, drifts)
-        return int(flown), int(after)
+        return int(flown), int(after), float(last)
 
     @property
     def takes_contacts(self) -> bool:

@@ -299,11 +299,12 @@ def test_intervals_equal_their_twin(count):
     want = [a.copy() for a in (position, velocity, acceleration)]
     record = np.empty((count, len(RECORD)))
     flown, after = smooth_intervals(*got, mass, radius, charge, 5.0, 0.0, *FREE, BOX, 5.0, 5.0,
-                                    np.nan, NONE, 0.0, 0, 0.05, count, 1, TOLERANCE, MOST, FLOOR,
-                                    0.0, record, np.empty(count))  # fmt: skip
+                                    np.nan, NONE, 0.0, 0, 0.05, count, 1, np.nan, True, TOLERANCE,
+                                    MOST, FLOOR, 0.0, record, np.empty(count))  # fmt: skip
     twin = reference.smooth_intervals(*want, mass, radius, charge, 5.0, 0.0, *FREE, BOX,
                                       np.array([5.0, 5.0]), np.nan, NONE, 0.0, 0, 0.05, count, 1,
-                                      TOLERANCE, MOST, FLOOR, 0.0, CONTACT_MARGIN)  # fmt: skip
+                                      TOLERANCE, MOST, FLOOR, 0.0, CONTACT_MARGIN,
+                                      keep=True)  # fmt: skip
     assert (flown, after) == (count, twin[1]) and twin[0] == count
     assert after >= 8  # the inner orbit needs substeps
     np.testing.assert_allclose(record, twin[2][:, :-1], rtol=1e-11, atol=1e-12)
@@ -323,8 +324,8 @@ def test_intervals_under_fields_equal_their_twin(kind):
     want = [a.copy() for a in (position, velocity, acceleration)]
     record, heat = np.empty((20, len(RECORD))), np.empty(20)
     flown, after = smooth_intervals(*got, mass, radius, charge, 5.0, 0.0, *external, BOX, 5.0,
-                                    5.0, np.nan, NONE, 0.0, 0, 0.05, 20, 1, TOLERANCE, MOST,
-                                    FLOOR, 1.5, record, heat)  # fmt: skip
+                                    5.0, np.nan, NONE, 0.0, 0, 0.05, 20, 1, np.nan, False,
+                                    TOLERANCE, MOST, FLOOR, 1.5, record, heat)  # fmt: skip
     twin = reference.smooth_intervals(*want, mass, radius, charge, 5.0, 0.0, *external, BOX,
                                       np.array([5.0, 5.0]), np.nan, NONE, 0.0, 0, 0.05, 20, 1,
                                       TOLERANCE, MOST, FLOOR, 1.5, CONTACT_MARGIN)  # fmt: skip
@@ -348,13 +349,13 @@ def test_an_interval_that_meets_a_wall_is_left_as_it_began():
     state = [a.copy() for a in (position, velocity, acceleration)]
     record = np.empty((10, len(RECORD)))
     flown, after = smooth_intervals(*state, mass, radius, charge, 5.0, 0.0, *FREE, BOX, 5.0,
-                                    5.0, np.nan, NONE, 0.0, 0, 0.05, 10, 1, TOLERANCE, MOST,
-                                    FLOOR, 0.0, record, np.empty(10))  # fmt: skip
+                                    5.0, np.nan, NONE, 0.0, 0, 0.05, 10, 1, np.nan, True,
+                                    TOLERANCE, MOST, FLOOR, 0.0, record, np.empty(10))  # fmt: skip
     assert 1 <= flown <= 3
     before = [a.copy() for a in (position, velocity, acceleration)]
     _, want = smooth_intervals(*before, mass, radius, charge, 5.0, 0.0, *FREE, BOX, 5.0, 5.0,
-                               np.nan, NONE, 0.0, 0, 0.05, flown, 1, TOLERANCE, MOST, FLOOR,
-                               0.0, record, np.empty(10))  # fmt: skip
+                               np.nan, NONE, 0.0, 0, 0.05, flown, 1, np.nan, True, TOLERANCE,
+                               MOST, FLOOR, 0.0, record, np.empty(10))  # fmt: skip
     assert after == want
     for ours, theirs in zip(state, before, strict=True):
         np.testing.assert_array_equal(ours, theirs)
@@ -367,8 +368,8 @@ def test_intervals_that_need_too_many_substeps_are_left_to_the_integrator():
     state = [position, np.zeros((2, 2)), np.zeros((2, 2))]
     flown, after = smooth_intervals(*state, np.ones(2), np.zeros(2), np.array([1.0, -1.0]), 5.0,
                                     0.0, *FREE, BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0, 1.0, 4, 2,
-                                    1e-4, 16, FLOOR, 0.0, np.empty((4, len(RECORD))),
-                                    np.empty(4))  # fmt: skip
+                                    np.nan, True, 1e-4, 16, FLOOR, 0.0,
+                                    np.empty((4, len(RECORD))), np.empty(4))  # fmt: skip
     assert (flown, after) == (0, 2)
     np.testing.assert_array_equal(state[0], [[0.0, 0.0], [0.001, 0.0]])
 

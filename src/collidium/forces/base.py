@@ -404,6 +404,13 @@ class ForceField:
         #: check is slow), or None where a force is none of those parts.
         self._compiled = _CompiledParts.of(self._position, self._velocity, self._carried)
         self._pair_laws = tuple(f for f in self._position if isinstance(f, PairLawForce))
+        #: Whether the forces are of the kinds whose modified energy is known
+        #: (`keeps_modified_energy`).
+        self._modified_energy_known = (
+            not self._velocity
+            and not any(self._carried)
+            and all(isinstance(f, PairLawForce | UniformPositionForce) for f in self._position)
+        )
         self._fall = np.zeros(2)
         for force, carried in zip(self._position, self._carried, strict=True):
             if carried:
@@ -555,6 +562,13 @@ class ForceField:
         """Whether every inverse-distance pair force is summed as its law's gradient
         (`PairLawForce.follows_law`)."""
         return all(force.follows_law(particles, vessel) for force in self._pair_laws)
+
+    def keeps_modified_energy(self, particles: Particles, vessel: Vessel) -> bool:
+        """Whether the substeps' modified energy is known here, so that the adaptive integrator
+        keeps it where the substep changes (`collidium.kernels.modified_energy`): the position
+        forces are pair laws summed as their gradients (`follows_laws`) and uniform fields,
+        whose Hessian is 0, the drift carries none of them, and no velocity force acts."""
+        return self._modified_energy_known and self.follows_laws(particles, vessel)
 
     def stiffness(self, particles: Particles, vessel: Vessel) -> float:
         """``S`` of all forces at the current state, in J^2/s^4: the largest of the forces'

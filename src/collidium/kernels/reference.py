@@ -288,6 +288,65 @@ def kick_timing_correction(
             take([int(row[0])] if partner < 0 else [int(row[0]), partner], drop, row[3:5])
 
 
+def modified_energy_terms(
+    position: FloatArray,
+    velocity: FloatArray,
+    acceleration: FloatArray,
+    mass: FloatArray,
+    laws: tuple[FloatArray, FloatArray, FloatArray],
+    size: FloatArray | None = None,
+) -> tuple[float, float]:
+    """Twin of `modified_energy.curvature_and_pulls`: ``(Q, P)``, ``Q`` the quadratic form
+    ``w . Hess(U) . w`` of every pair's relative velocity, all pairs at once, ``P`` the sum of
+    ``m |a|^2``, of the pair ``laws`` (sources (L, N), couplings and squared softenings (L,));
+    ``size`` (the box sides) turns on the minimum image."""
+    sources, couplings, softenings2 = laws
+    d = position[:, None, :] - position[None, :, :]
+    if size is not None:
+        d -= size * np.round(d / size)
+    w = velocity[:, None, :] - velocity[None, :, :]
+    curvature = 0.0
+    for q, k, eps2 in zip(sources, couplings, softenings2, strict=True):
+        u = np.einsum("ijk,ijk->ij", d, d) + eps2
+        np.fill_diagonal(u, np.inf)
+        along = np.einsum("ijk,ijk->ij", d, w)
+        # Hess(k q_i q_j / sqrt(u)) = k q_i q_j (3 d d^T / u^(5/2) - I / u^(3/2))
+        square = np.einsum("ijk,ijk->ij", w, w)
+        form = k * np.outer(q, q) * (3.0 * along**2 / u**2.5 - square / u**1.5)
+        curvature += 0.5 * float(form.sum())  # each pair twice
+    return curvature, float(np.sum(mass * np.sum(acceleration**2, axis=1)))
+
+
+def modified_energy_keep(
+    position: FloatArray,
+    velocity: FloatArray,
+    acceleration: FloatArray,
+    mass: FloatArray,
+    laws: tuple[FloatArray, FloatArray, FloatArray],
+    steps: tuple[float, float],
+    limit: float,
+    size: FloatArray | None = None,
+) -> float:
+    """Twin of `modified_energy.keep_across_step`: the velocities about the centre of mass
+    scaled, in place, by the factor f with ``KE + U + h^2 (Q / 12 - P / 24)`` the same before
+    and after ``steps``, the substep (s) before and after, unless f is further than ``limit``
+    from 1; returns the energy given (J, 0 where left)."""
+    substep, following = steps
+    curvature, pulls = modified_energy_terms(position, velocity, acceleration, mass, laws, size)
+    centre = mass @ velocity / mass.sum()
+    internal = 0.5 * float(np.sum(mass * np.sum((velocity - centre) ** 2, axis=1)))
+    if not internal > 0.0:
+        return 0.0
+    before = internal + substep**2 * (curvature / 12.0 - pulls / 24.0)
+    factor = math.sqrt(
+        (before + following**2 * pulls / 24.0) / (internal + following**2 * curvature / 12.0)
+    )
+    if not abs(factor - 1.0) <= limit:
+        return 0.0
+    velocity[...] = centre + factor * (velocity - centre)
+    return internal * (factor**2 - 1.0)
+
+
 def first_overlap(position: FloatArray, radius: FloatArray) -> tuple[int, int]:
     """The overlapping pair with the smallest (i, j), or (-1, -1); all pairs, reflecting box."""
     d = np.linalg.norm(position[:, None] - position[None, :], axis=2)
@@ -1196,13 +1255,17 @@ def smooth_intervals(
     energy_floor: float,
     given: float,
     margin: float,
-) -> tuple[int, int, FloatArray]:
+    substep: float = math.nan,
+    keep: bool = False,
+) -> tuple[int, int, FloatArray, float]:
     """Twin of `substeps.smooth_intervals`: interval by interval, the substep count from the
-    rate at its start (`needed`), `smooth_substeps` from its first substep, taken again with
-    more substeps while a boundary needs more; the first interval that meets a contact is put
-    back as it began. Returns ``(intervals taken, the next count, the record of each: kinetic
-    and potential energy, pair virial, momentum x and y, total speed, the energy the drag has
-    given since ``given`` J before the first)``."""
+    rate at its start (`needed`), the modified energy kept where the substep changes from the
+    last (``substep`` s before the first, NaN for none) if ``keep`` (`modified_energy_keep`),
+    `smooth_substeps` from its first substep, taken again with more substeps while a boundary
+    needs more; the first interval that meets a contact is put back as it began. Returns
+    ``(intervals taken, the next count, the record of each: kinetic and potential energy, pair
+    virial, momentum x and y, total speed, the energy the drag has given since ``given`` J
+    before the first; the last interval's substep, s)``."""
     record: list[tuple[float, ...]] = []
 
     def energies() -> tuple[float, float, float]:
@@ -1222,10 +1285,15 @@ def smooth_intervals(
         rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, turn, damp,
                              total, energy_floor)  # fmt: skip
         if not dt * math.sqrt(rate2) <= most * tolerance:
-            return k, substeps, np.array(record).reshape(-1, 7)
+            return k, substeps, np.array(record).reshape(-1, 7), substep
         taken = max(substeps, needed(rate2, dt, tolerance, most))
         start = [a.copy() for a in (position, velocity, acceleration)]
         while True:
+            if keep and not math.isnan(substep) and dt / taken != substep:
+                laws = (source[None, :], np.array([coupling]), np.array([softening2]))
+                modified_energy_keep(
+                    position, velocity, acceleration, mass, laws, (substep, dt / taken), tolerance
+                )
             reached, _, fastest, drag = smooth_substeps(
                 position, velocity, acceleration, mass, radius, source, coupling, softening2,
                 uniform, fall, turn, region, damp, shape, half, rim, table, now, dt, 1, taken,
@@ -1237,11 +1305,12 @@ def smooth_intervals(
                 for array, kept in zip((position, velocity, acceleration), start, strict=True):
                     array[...] = kept
             if met:
-                return k, substeps, np.array(record).reshape(-1, 7)
+                return k, substeps, np.array(record).reshape(-1, 7), substep
             if required <= taken:
                 break
             taken = max(required, 2 * taken)
         substeps = max(1, taken // 2) if required <= taken // 2 else taken
+        substep = dt / taken
         given += drag
         record.append(table_row())
-    return count, substeps, np.array(record).reshape(-1, 7)
+    return count, substeps, np.array(record).reshape(-1, 7), substep

@@ -29,6 +29,7 @@ import numpy as np
 from collidium.kernels import events, kick_timing
 from collidium.kernels.compilation import uncounted
 from collidium.kernels.floats import largest_magnitude
+from collidium.kernels.modified_energy import keep_across_step
 from collidium.kernels.pairwise import (
     MOST_BLOCKS,
     PRUNE_FROM,
@@ -143,9 +144,9 @@ def smooth_substeps(
 def smooth_intervals(
     position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, fall,
     turn, region, damp, shape, half_width, half_height, rim, segments, origin, elapsed, dt,
-    count, substeps, tolerance, most_substeps, energy_floor, given, record, heat, contacts,
-    counts, impulses, heats,
-) -> tuple[int, int, int, int]:  # fmt: skip
+    count, substeps, substep, keep, tolerance, most_substeps, energy_floor, given, record, heat,
+    contacts, counts, impulses, heats,
+) -> tuple[int, int, float, int, int]:  # fmt: skip
     """Up to ``count`` whole reporting intervals of ``dt`` (s), in place, each as the adaptive
     integrator takes one (`collidium.integrators.AdaptiveLeapfrog`), up to the first that meets
     a contact the engine cannot take here or a value that is not finite, or needs more than
@@ -154,7 +155,9 @@ def smooth_intervals(
     Interval k starts at ``origin + (elapsed + k) dt``, the simulation's clock. Its substep count
     is the larger of ``substeps`` and the fewest the rate at its start needs (`needed`); it is
     taken again with more if a substep boundary needs more, and the count the next interval
-    starts from is this one, or half of it when half would have done.
+    starts from is this one, or half of it when half would have done. Where its substep differs
+    from the one before, and ``keep``, the velocities are first scaled so that the substeps'
+    modified energy goes on (`collidium.kernels.modified_energy.keep_across_step`).
 
     Parameters
     ----------
@@ -171,8 +174,14 @@ def smooth_intervals(
         Most intervals to take (at most ``len(record)``).
     substeps : int
         The substep count the first interval starts from.
+    substep : float
+        The substep of the interval before the first, s (NaN for none).
+    keep : bool
+        Whether to keep the modified energy where the substep changes: the forces are the pair
+        force and a uniform field, none carried by the drift, and no velocity force.
     tolerance : float
-        The integrator's accuracy parameter (`needed`).
+        The integrator's accuracy parameter (`needed`), and the most by which the modified
+        energy's keeping may scale the velocities.
     most_substeps : int
         Most substeps in an interval (a power of two).
     energy_floor : float
@@ -194,9 +203,9 @@ def smooth_intervals(
 
     Returns
     -------
-    tuple of int
-        ``(intervals taken, the substep count the next interval starts from, events, drifts)``:
-        the events the engine processed in the drifts it took.
+    tuple
+        ``(intervals taken, the substep count the next interval starts from, the last interval's
+        substep in s, events, drifts)``: the events the engine processed in the drifts it took.
     """
     n = position.shape[0]
     work = _work(mass, source, coupling, softening2, contacts[-3:])
@@ -213,13 +222,16 @@ def smooth_intervals(
         now = origin + (elapsed + k) * dt
         total = kinetic_energy(mass, velocity) + energy
         rate2 = _squared_rate(position, velocity, mass, coupling, softening2, flows2, total,
-                              energy_floor, sources, work[21:])  # fmt: skip
+                              energy_floor, sources, work[21:23])  # fmt: skip
         if not dt * math.sqrt(rate2) <= most_substeps * tolerance:  # also NaN
-            return k, substeps, processed, drifts
+            return k, substeps, substep, processed, drifts
         taken = max(substeps, needed(rate2, dt, tolerance, most_substeps))
         _keep(position, velocity, acceleration, start)
         _keep_tally(tally, kept)
         while True:
+            if keep and dt / taken != substep:  # NaN: none before
+                _keep_modified_energy(position, velocity, acceleration, mass, work, substep,
+                                      dt / taken, tolerance)  # fmt: skip
             s, _, fastest, drag, done, drifted = _substeps(
                 position, velocity, acceleration, mass, radius, coupling, softening2, external,
                 walls, now, dt, 1, taken, now, rate2, total, energy_floor, work, contacts,
@@ -227,7 +239,7 @@ def smooth_intervals(
             if s <= taken:  # a contact left to Python, or a value not finite
                 _restore(position, velocity, acceleration, start)
                 _keep_tally(kept, tally)
-                return k, substeps, processed, drifts
+                return k, substeps, substep, processed, drifts
             processed += done
             drifts += drifted
             required = needed(fastest, dt, tolerance, most_substeps)
@@ -237,6 +249,7 @@ def smooth_intervals(
             _keep_tally(kept, tally)
             taken = max(required, 2 * taken)
         substeps = max(1, taken // 2) if required <= taken // 2 else taken
+        substep = dt / taken
         given += drag
         heat[k] = given
         # The last substep's pair sums are of the positions now.
@@ -252,7 +265,19 @@ def smooth_intervals(
             counts[k, w] = tally[0][w]
             impulses[k, w] = tally[1][w]
             heats[k, w] = tally[2][w]
-    return count, substeps, processed, drifts
+    return count, substeps, substep, processed, drifts
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _keep_modified_energy(position, velocity, acceleration, mass, work, substep, following,
+                          limit) -> None:  # fmt: skip
+    """`collidium.kernels.modified_energy.keep_across_step` from substeps of ``substep`` to
+    ``following`` (s; nothing if ``substep`` is NaN), with the pair force's law of `_work`, the
+    vessel's walls making the minimum image needless."""
+    if substep == substep:
+        sources, couplings, softenings2 = work[15:18]
+        keep_across_step(position, velocity, acceleration, mass, sources, couplings, softenings2,
+                         0.0, 0.0, False, work[23], substep, following, limit)  # fmt: skip
 
 
 @numba.njit(cache=True)
@@ -276,7 +301,8 @@ def _work(mass, source, coupling, softening2, tally):
     sweep's order and interval ends (N,) (`_meets_contact`); the pair force's law as
     `collidium.kernels.kick_timing.correct` takes it (sources (1, N), coupling and squared
     softening (1,)); a copy of the ``tally``'s counts, impulses and heat, to put back; the
-    order and rows of `collidium.kernels.pairwise.pruned_stiffness` (m,) and (6, m)."""
+    order and rows of `collidium.kernels.pairwise.pruned_stiffness` (m,) and (6, m); the rows
+    of `collidium.kernels.modified_energy.keep_across_step` (4, N)."""
     n = mass.shape[0]
     m = 0
     for i in range(n):
@@ -296,9 +322,10 @@ def _work(mass, source, coupling, softening2, tally):
     law = (source.copy().reshape((1, n)), np.full(1, coupling), np.full(1, softening2))
     kept = (tally[0].copy(), tally[1].copy(), tally[2].copy())
     pruning = (np.arange(m), np.empty((6, m)))
+    gathered = (np.empty((4, n)),)
     # Concatenated: numba builds an unpacked (*a, *b) through a list, which holds one type.
     return (motion + (index, charged, inverse_mass) + rows + sums + sweep + law  # noqa: RUF005
-            + kept + pruning)  # fmt: skip
+            + kept + pruning + gathered)  # fmt: skip
 
 
 @uncounted(error_model="numpy")
@@ -319,7 +346,7 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     log, logged = contacts[4:6]
     tally = contacts[-3:]
     kept = work[18:21]
-    order_x, rows_x = work[21:]
+    order_x, rows_x = work[21:23]
     engine = contacts[2] > 0  # events between re-sorts: 0 for no engine
     n = position.shape[0]
     given = 0.0
@@ -327,7 +354,7 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     flows2 = _flows2(turn, damp)
     if fastest < 0.0:
         fastest = _squared_rate(position, velocity, mass, coupling, softening2, flows2, total,
-                                energy_floor, work[3:12], work[21:])  # fmt: skip
+                                energy_floor, work[3:12], work[21:23])  # fmt: skip
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
