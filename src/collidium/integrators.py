@@ -56,8 +56,8 @@ DEFAULT_TOLERANCE = 0.002
 #: at its start stops the run with one line (the forces are too strong for this dt, and it would
 #: take minutes); one that finds out only as it goes is taken with this many, and the energy
 #: check of the run reports the error. The seed's point charges passing through each other
-#: (charged-no-collisions) take up to 2^14 substeps a dt at the default tolerance: sixteen times
-#: that leaves room for a tolerance eight times finer, twice over.
+#: (charged-no-collisions) take up to 2^13 substeps a dt at the default tolerance and 2^17 at a
+#: sixteenth of it: this leaves room for that, twice over.
 MAX_SUBSTEPS = 2**18
 
 #: The energy scale of the substep criterion is the total energy, but at least ``KE + |U|``
