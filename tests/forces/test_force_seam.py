@@ -201,3 +201,38 @@ def test_a_scenario_names_the_bad_force_parameter(force, field, reason):
         Scenario.from_dict({**data, "forces": [force]})
     assert info.value.field == field
     assert reason in info.value.reason
+
+
+@pytest.mark.parametrize(
+    ("forces", "known"),
+    [
+        (["coulomb"], True),
+        (["coulomb", "newton", "uniform_field"], True),
+        (["uniform_field"], False),  # followed exactly: its modified energy is the energy
+        (["coulomb", "magnetic_field"], False),
+        (["coulomb", "linear_drag"], False),
+        (["coulomb", "field_map"], False),
+    ],
+)
+def test_the_modified_energy_is_kept_where_it_is_known(forces, known):
+    """Where the substep changes, the adaptive integrator keeps the substeps' modified energy
+    (`collidium.kernels.modified_energy`) only for pair laws summed as their gradients and
+    uniform fields: not beside a velocity force, a field map, a gravity the drift carries, a
+    tree or a limiter."""
+    particles = Particles([[-1.0, 0.0], [1.0, 0.0]], charge=[1.0, -1.0])
+    field = ForceField(tuple(EXAMPLES[name] for name in forces))
+    assert field.keeps_modified_energy(particles, Box(10, 10)) is known
+
+
+@pytest.mark.parametrize(
+    "forces",
+    [
+        (Coulomb(k=5.0, method="tree"),),
+        (Coulomb(k=5.0, max_acceleration=10.0),),
+        (Coulomb(k=5.0), Gravity(g=(0.0, -9.81))),
+    ],
+)
+def test_the_modified_energy_is_not_kept_by_tree_limiter_or_carried_gravity(forces):
+    particles = Particles([[-1.0, 0.0], [1.0, 0.0]], charge=[1.0, -1.0])
+    field = ForceField(forces, carry_fall=True)
+    assert not field.keeps_modified_energy(particles, Box(10, 10))

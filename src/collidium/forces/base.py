@@ -404,10 +404,11 @@ class ForceField:
         #: check is slow), or None where a force is none of those parts.
         self._compiled = _CompiledParts.of(self._position, self._velocity, self._carried)
         self._pair_laws = tuple(f for f in self._position if isinstance(f, PairLawForce))
-        #: Whether the forces are of the kinds whose modified energy is known
-        #: (`keeps_modified_energy`).
+        #: Whether the forces are of the kinds whose modified energy is known, with a pair law
+        #: among them (`keeps_modified_energy`).
         self._modified_energy_known = (
-            not self._velocity
+            bool(self._pair_laws)
+            and not self._velocity
             and not any(self._carried)
             and all(isinstance(f, PairLawForce | UniformPositionForce) for f in self._position)
         )
@@ -567,7 +568,9 @@ class ForceField:
         """Whether the substeps' modified energy is known here, so that the adaptive integrator
         keeps it where the substep changes (`collidium.kernels.modified_energy`): the position
         forces are pair laws summed as their gradients (`follows_laws`) and uniform fields,
-        whose Hessian is 0, the drift carries none of them, and no velocity force acts."""
+        whose Hessian is 0, the drift carries none of them, and no velocity force acts. Without
+        a pair law there is nothing to keep: leapfrog follows uniform fields exactly, and their
+        modified energy differs from the energy by a constant."""
         return self._modified_energy_known and self.follows_laws(particles, vessel)
 
     def stiffness(self, particles: Particles, vessel: Vessel) -> float:
