@@ -347,7 +347,7 @@ class AdaptiveLeapfrog(Integrator):
         n = max(self.substeps, self.needed(rate2, dt))
         keep = field.keeps_modified_energy(particles, vessel)
         while True:
-            if keep and dt / n != self.substep:  # NaN: none before
+            if keep and not math.isnan(self.substep) and dt / n != self.substep:
                 _keep_modified_energy(particles, vessel, field, self.substep, dt / n,
                                       self.tolerance)  # fmt: skip
             try:
@@ -527,11 +527,9 @@ def _corrected(
 
 def _keep_modified_energy(particles: Particles, vessel: Vessel, field: ForceField,
                           substep: float, following: float, limit: float) -> None:  # fmt: skip
-    """Keep the substeps' modified energy from substeps of ``substep`` to ``following`` (s;
-    nothing if ``substep`` is NaN), the velocities scaled by at most ``limit``
+    """Keep the substeps' modified energy from substeps of ``substep`` to ``following`` (s),
+    the velocities scaled by at most ``limit``
     (`collidium.kernels.modified_energy.keep_across_step`)."""
-    if math.isnan(substep):
-        return
     width, height = (float(side) for side in vessel.size)
     modified_energy.keep_across_step(
         particles.position, particles.velocity, field.acceleration, writable(particles.mass),

@@ -229,7 +229,7 @@ def smooth_intervals(
         _keep(position, velocity, acceleration, start)
         _keep_tally(tally, kept)
         while True:
-            if keep and dt / taken != substep:  # NaN: none before
+            if keep and substep == substep and dt / taken != substep:  # NaN: none before
                 _keep_modified_energy(position, velocity, acceleration, mass, work, substep,
                                       dt / taken, tolerance)  # fmt: skip
             s, _, fastest, drag, done, drifted = _substeps(
@@ -272,12 +272,11 @@ def smooth_intervals(
 def _keep_modified_energy(position, velocity, acceleration, mass, work, substep, following,
                           limit) -> None:  # fmt: skip
     """`collidium.kernels.modified_energy.keep_across_step` from substeps of ``substep`` to
-    ``following`` (s; nothing if ``substep`` is NaN), with the pair force's law of `_work`, the
-    vessel's walls making the minimum image needless."""
-    if substep == substep:
-        sources, couplings, softenings2 = work[15:18]
-        keep_across_step(position, velocity, acceleration, mass, sources, couplings, softenings2,
-                         0.0, 0.0, False, work[23], substep, following, limit)  # fmt: skip
+    ``following`` (s), with the pair force's law of `_work`, the vessel's walls making the
+    minimum image needless."""
+    sources, couplings, softenings2 = work[15:18]
+    keep_across_step(position, velocity, acceleration, mass, sources, couplings, softenings2,
+                     0.0, 0.0, False, work[23], substep, following, limit)  # fmt: skip
 
 
 @numba.njit(cache=True)
