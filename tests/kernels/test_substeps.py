@@ -34,7 +34,8 @@ def smooth_intervals(*arguments):
     """`substeps.smooth_intervals` without an engine: ``(intervals, next count)``."""
     count = arguments[21]
     tallies = (np.empty((count, 5), dtype=np.int64), np.empty((count, 5)), np.empty((count, 5)))
-    return substeps.smooth_intervals(*arguments, no_engine(), *tallies)[:2]
+    shown = (False, np.zeros(count, dtype=bool), (0.0, 0.0, 0.0))  # the record of the state
+    return substeps.smooth_intervals(*arguments, no_engine(), *tallies, *shown)[:2]
 
 
 FLOOR = 10.0
@@ -316,6 +317,40 @@ def test_intervals_equal_their_twin(count):
     np.testing.assert_allclose(record, twin[2][:, :-1], rtol=1e-11, atol=1e-12)
     for ours, theirs in zip(got, want, strict=True):
         np.testing.assert_allclose(ours, theirs, rtol=1e-10, atol=1e-12)
+
+
+def test_a_wanted_interval_records_the_processed_state():
+    """Three intervals shown processed, the last one's record wanted: it holds the energies,
+    virial, momentum and total speed of the processed state of the motion there (its NumPy
+    twin, `reference.processed_state`, of the last substep); the other rows and the motion
+    itself are those of the intervals taken without the processing, bit for bit."""
+    position, velocity, mass, radius, charge = three_bodies()
+    acceleration = accelerations(position, mass, charge, 5.0, 0.0)
+    runs = []
+    for shows in (False, True):
+        state = [a.copy() for a in (position, velocity, acceleration)]
+        record = np.empty((3, len(RECORD)))
+        tallies = (np.empty((3, 5), dtype=np.int64), np.empty((3, 5)), np.empty((3, 5)))
+        _, _, substep, _, _ = substeps.smooth_intervals(
+            *state, mass, radius, charge, 5.0, 0.0, *FREE, BOX, 5.0, 5.0, np.nan, NONE, 0.0, 0,
+            0.05, 3, 1, np.nan, True, TOLERANCE, MOST, FLOOR, 0.0, record, np.empty(3),
+            no_engine(), *tallies, shows, np.array([False, False, True]),
+            Box(10, 10).audit_arguments()[1:4],
+        )  # fmt: skip
+        runs.append((state, record, substep))
+    (plain, plain_record, substep), (state, record, _) = runs
+    for ours, theirs in zip(state, plain, strict=True):
+        np.testing.assert_array_equal(ours, theirs)
+    np.testing.assert_array_equal(record[:2], plain_record[:2])
+    laws = (charge[None, :], np.array([5.0]), np.array([0.0]))
+    curved = reference.curved_velocities(state[0], state[1], laws)
+    walls = (BOX, *Box(10, 10).audit_arguments()[1:4], NONE)
+    x, v, _ = reference.processed_state(*state[:3], mass, curved, substep**2 / 12, radius, walls)
+    assert not np.array_equal(x, state[0])
+    _, halves, virials = reference.inverse_distance_direct(x, charge, 5.0, 0.0)
+    speed = float(np.sum(np.hypot(v[:, 0], v[:, 1])))
+    want = [kinetic_energy(mass, v), halves.sum(), virials.sum(), *(mass @ v), speed]
+    np.testing.assert_allclose(record[2], want, rtol=1e-12)
 
 
 @pytest.mark.parametrize("kind", ["electric", "falling"])

@@ -347,6 +347,67 @@ def modified_energy_keep(
     return internal * (factor**2 - 1.0)
 
 
+def curved_velocities(
+    position: FloatArray,
+    velocity: FloatArray,
+    laws: tuple[FloatArray, FloatArray, FloatArray],
+) -> FloatArray:
+    """Twin of `processing.curved_velocities`: ``sum_j Hess(U_ij) (v_i - v_j)`` (N, 2), N/s, of
+    the pair ``laws`` (sources (L, N), couplings and squared softenings (L,)), all pairs at
+    once."""
+    sources, couplings, softenings2 = laws
+    d = position[:, None, :] - position[None, :, :]
+    w = velocity[:, None, :] - velocity[None, :, :]
+    out = np.zeros_like(position)
+    for q, k, eps2 in zip(sources, couplings, softenings2, strict=True):
+        u = np.einsum("ijk,ijk->ij", d, d) + eps2
+        np.fill_diagonal(u, np.inf)
+        along = np.einsum("ijk,ijk->ij", d, w)[..., None]
+        scale = (k * np.outer(q, q) / u**1.5)[..., None]
+        out += np.sum(scale * (3.0 * along * d / u[..., None] - w), axis=1)
+    return out
+
+
+def processed_state(
+    position: FloatArray,
+    velocity: FloatArray,
+    acceleration: FloatArray,
+    mass: FloatArray,
+    curved: FloatArray,
+    scale: float,
+    radius: FloatArray,
+    vessel: tuple[int, float, float, float, FloatArray],
+) -> tuple[FloatArray, FloatArray, int]:
+    """Twin of `processing.shown`: ``(x + scale a, v + scale curved / m, disks put back)``, a
+    disk put back to its own position while its shift brings it past a wall (`first_invalid`
+    on it alone) or closer to another disk (both radii > 0) than both their contact and their
+    distance before."""
+    shape, limit_x, limit_y, slack, table = vessel
+    shifted = position + scale * acceleration
+    moving = velocity + scale * curved / mass[:, None]
+    moved = np.ones(len(position), dtype=bool)
+    before = np.sum((position[:, None, :] - position[None, :, :]) ** 2, axis=2)
+    contact = (radius[:, None] + radius[None, :]) ** 2
+    disks = (radius[:, None] > 0.0) & (radius[None, :] > 0.0)
+    np.fill_diagonal(disks, False)
+    kept = 0
+    while True:
+        outside = [
+            first_invalid(shifted[i : i + 1], moving[i : i + 1], radius[i : i + 1], shape,
+                          limit_x, limit_y, slack, False, table)[1] == 2
+            for i in range(len(position))
+        ]  # fmt: skip
+        back = moved & np.array(outside, dtype=bool)
+        now = np.sum((shifted[:, None, :] - shifted[None, :, :]) ** 2, axis=2)
+        close = disks & (now < np.minimum(contact, before)) & (moved[:, None] | moved[None, :])
+        back |= moved & close.any(axis=1)
+        if not back.any():
+            return shifted, moving, kept
+        shifted[back] = position[back]
+        moved &= ~back
+        kept += int(back.sum())
+
+
 def first_overlap(position: FloatArray, radius: FloatArray) -> tuple[int, int]:
     """The overlapping pair with the smallest (i, j), or (-1, -1); all pairs, reflecting box."""
     d = np.linalg.norm(position[:, None] - position[None, :], axis=2)

@@ -14,9 +14,11 @@ cell crossing, in two roundings where the straight flight here takes one.
 
 `smooth_intervals` goes further: it takes whole reporting intervals, as many as meet no contact,
 with the integrator's choice of their substep counts and its retries, and records the energies,
-virial, momentum and total speed at each interval's end (`RECORD`), so that a small scene runs
-many steps between the observers that read more of its state in one call. An interval that meets
-a contact is left to the integrator whole.
+virial, momentum and total speed at each interval's end (`RECORD`; of the processed state the
+integrator shows, where it shows one and an observer reads them:
+`collidium.kernels.processing`), so that a small scene runs many steps between the observers
+that read more of its state in one call. An interval that meets a contact is left to the
+integrator whole.
 """
 
 from __future__ import annotations
@@ -37,6 +39,8 @@ from collidium.kernels.pairwise import (
     pair_sums,
     pruned_stiffness,
 )
+from collidium.kernels.processing import SHARE, curved_velocities
+from collidium.kernels.processing import shown as processed
 from collidium.kernels.sorting import sort_nearly_sorted
 from collidium.kernels.sums import kinetic_energy, momentum, total_speed
 from collidium.kernels.vessels import BOX, CIRCLE, contacts
@@ -145,7 +149,7 @@ def smooth_intervals(
     position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, fall,
     turn, region, damp, shape, half_width, half_height, rim, segments, origin, elapsed, dt,
     count, substeps, substep, keep, tolerance, most_substeps, energy_floor, given, record, heat,
-    contacts, counts, impulses, heats,
+    contacts, counts, impulses, heats, shows, wanted, limits,
 ) -> tuple[int, int, float, int, int]:  # fmt: skip
     """Up to ``count`` whole reporting intervals of ``dt`` (s), in place, each as the adaptive
     integrator takes one (`collidium.integrators.AdaptiveLeapfrog`), up to the first that meets
@@ -200,6 +204,14 @@ def smooth_intervals(
         As in `smooth_substeps`.
     counts, impulses, heats : ndarray, shape (count, 1 + W)
         Output: the tally's counts, impulses and heat at each interval's end.
+    shows : bool
+        Whether the ``record`` of an interval that is ``wanted`` is that of the processed state
+        (`collidium.kernels.processing`), the state the integrator shows.
+    wanted : ndarray of bool, shape (count,)
+        The intervals whose record is read.
+    limits : tuple
+        ``(limit_x, limit_y, slack)``: the walls as the audit takes them
+        (`collidium.vessels.Vessel.audit_arguments`), for the processing.
 
     Returns
     -------
@@ -218,6 +230,9 @@ def smooth_intervals(
     start = np.empty((3, n, 2))
     sources = work[3:12]
     energy, virial = _energies(position, coupling, softening2, uniform, sources)
+    shown = np.empty((3, n, 2))  # the processed positions and velocities, the curved velocities
+    guard = (np.arange(n), np.empty((3, n)), np.empty((6, n)))
+    vessel = (shape, limits[0], limits[1], limits[2], segments)
     for k in range(count):
         now = origin + (elapsed + k) * dt
         total = kinetic_energy(mass, velocity) + energy
@@ -254,18 +269,44 @@ def smooth_intervals(
         heat[k] = given
         # The last substep's pair sums are of the positions now.
         energy, virial = _summed_energies(position, uniform, work[10])
-        px, py = momentum(mass, velocity)
-        record[k, 0] = kinetic_energy(mass, velocity)
-        record[k, 1] = energy
-        record[k, 2] = virial
-        record[k, 3] = px
-        record[k, 4] = py
-        record[k, 5] = total_speed(velocity)
+        if shows and wanted[k]:
+            _show(position, velocity, acceleration, mass, radius, work[15:18], substep,
+                  vessel, guard, shown)  # fmt: skip
+            shown_energy, shown_virial = _energies(shown[0], coupling, softening2, uniform,
+                                                   sources)  # fmt: skip
+            _record(k, mass, shown[1], shown_energy, shown_virial, record)
+        else:
+            _record(k, mass, velocity, energy, virial, record)
         for w in range(counts.shape[1]):
             counts[k, w] = tally[0][w]
             impulses[k, w] = tally[1][w]
             heats[k, w] = tally[2][w]
     return count, substeps, substep, processed, drifts
+
+
+@numba.njit(cache=True, inline="always")
+def _record(k, mass, velocity, energy, virial, record) -> None:
+    """Row k of the `RECORD` of a state of ``velocity`` (N, 2), its potential ``energy`` and
+    pair ``virial`` (J)."""
+    px, py = momentum(mass, velocity)
+    record[k, 0] = kinetic_energy(mass, velocity)
+    record[k, 1] = energy
+    record[k, 2] = virial
+    record[k, 3] = px
+    record[k, 4] = py
+    record[k, 5] = total_speed(velocity)
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _show(position, velocity, acceleration, mass, radius, law, substep, vessel, guard,
+          shown) -> None:  # fmt: skip
+    """The processed state of substeps of ``substep`` (s) into ``shown[0]`` and ``shown[1]``
+    (`collidium.kernels.processing.shown`), the curved velocities into ``shown[2]``; ``guard``
+    the processing's work arrays (order, extents, rows)."""
+    order, extents, rows = guard
+    curved_velocities(position, velocity, law[0], law[1], law[2], rows, shown[2])
+    processed(position, velocity, acceleration, mass, shown[2], SHARE * substep * substep,
+              radius, vessel, order, extents, shown[0], shown[1])  # fmt: skip
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
