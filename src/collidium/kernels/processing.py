@@ -73,7 +73,7 @@ def _curved_row(i, x, y, vx, vy, source, softening2, coupled, hx, hy) -> None:
 @uncounted(error_model="numpy")
 def curved_velocities(position, velocity, sources, couplings, softenings2, rows, out) -> None:
     """``out`` (N, 2) in N/s: ``sum_j Hess(U_ij) (v_i - v_j)`` over the pair laws, each pair
-    once, ``U_ij = c s_i s_j / sqrt(r^2 + eps^2)``.
+    once, ``U_ij = k s_i s_j / sqrt(r^2 + eps^2)``.
 
     Parameters
     ----------
