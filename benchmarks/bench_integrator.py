@@ -92,7 +92,7 @@ def against_tolerance(seconds: float = 20.0) -> list[dict[str, object]]:
     return rows
 
 
-GAS_TOLERANCES = (6e-3, DEFAULT_TOLERANCE, 3e-3, 2e-3, 1e-3)
+GAS_TOLERANCES = (6e-3, 4e-3, DEFAULT_TOLERANCE, 2e-3, 1e-3)
 
 
 def gas_cost(seconds: float) -> list[dict[str, object]]:

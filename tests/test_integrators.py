@@ -117,7 +117,7 @@ def test_a_change_of_substep_keeps_the_modified_energy(monkeypatch):
     """Two opposite charges fall together and collide again and again, the substeps shortening
     for each close approach and lengthening after it: with the modified energy kept at each
     change (`collidium.kernels.modified_energy`) the integrator's own state errs five times
-    less over 10 s than with the jumps left (2.1e-6 against 1.1e-5; its own state, not the
+    less over 10 s than with the jumps left (1.0e-6 against 6.7e-6; its own state, not the
     processed one shown)."""
     monkeypatch.setattr(integrators, "shows", lambda *arguments: False)
     kept = max_drift(cd.load("charged-opposite"), 10.0)
@@ -128,7 +128,7 @@ def test_a_change_of_substep_keeps_the_modified_energy(monkeypatch):
 
 def test_the_state_shown_is_the_processed_one(monkeypatch):
     """The same charges: the processed state shown (`collidium.kernels.processing`) errs
-    fifteen times less over 10 s than the integrator's own (1.4e-7 against 2.1e-6): the
+    twelve times less over 10 s than the integrator's own (8.0e-8 against 1.0e-6): the
     curvature's share of the swing is gone."""
     shown = max_drift(cd.load("charged-opposite"), 10.0)
     monkeypatch.setattr(integrators, "shows", lambda *arguments: False)

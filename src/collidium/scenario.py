@@ -36,7 +36,7 @@ A scenario file::
     time = 10.0                   # s, default duration of `collidium run`
     collisions = "exact"          # "exact" | "step" | "off"
     integrator = "adaptive"       # "adaptive" (substeps as the forces need) | "fixed" (seed's)
-    tolerance = 0.004             # the adaptive integrator's accuracy (energy error ~ its square)
+    tolerance = 0.003             # the adaptive integrator's accuracy (energy error ~ its square)
     restitution = 1.0             # of the pair collisions, in (0, 1]: below 1, a granular gas
 
     [[forces]]
