@@ -339,26 +339,24 @@ class AdaptiveLeapfrog(Integrator):
             self._shown = None
             yield
             return
-        given = (particles.position.copy(), particles.velocity.copy())
         if self._shown is None or not self._shown.matches(particles, vessel, field):
             if math.isnan(self.substep):  # the substep that the first interval starts from
                 self.substep = dt / self.needed(self._start_rate(particles, vessel, field), dt)
             self._shown = _Shown.behind(particles, vessel, field, self.substep)
-        self._shown.resume(particles, vessel, field)
+        before = self._shown
+        before.resume(particles, vessel, field)
         try:
             yield
         except BaseException:
-            particles.position[...], particles.velocity[...] = given
+            particles.position[...] = before.shown_position
+            particles.velocity[...] = before.shown_velocity
             raise
-        self._shown = _Shown.show(particles, vessel, field, self.substep)
+        self._shown = _Shown.show(particles, vessel, field, self.substep, before.made_with)
 
     def _start_rate(self, particles: Particles, vessel: Vessel, field: ForceField) -> float:
         """`_squared_rate` of the particles as they are (1/s^2)."""
         field.refresh(particles, vessel)
-        total = sums.kinetic_energy(particles.mass, particles.velocity) + field.potential(
-            particles, vessel
-        )
-        return _squared_rate(particles, vessel, field, total)
+        return _squared_rate(particles, vessel, field, _total(particles, vessel, field))
 
     def needed(self, rate2: float, dt: float) -> int:
         """The fewest substeps, a power of two up to `MAX_SUBSTEPS`, that keep ``dt / n`` within
@@ -384,9 +382,7 @@ class AdaptiveLeapfrog(Integrator):
             start = _Snapshot(particles, tally)
             # The energy the substeps' rate is judged against: the interval's one read of the
             # energies (the forces keep the total within the tolerance over the interval).
-            total = sums.kinetic_energy(particles.mass, particles.velocity) + field.potential(
-                particles, vessel
-            )
+            total = _total(particles, vessel, field)
             evaluated = field.saved()  # put back with the particles: no evaluation to take it again
             rate2 = (
                 _squared_rate(particles, vessel, field, total)
@@ -624,6 +620,13 @@ def _given(tally: Tally) -> float:
     """The energy (J) given to the particles so far by the velocity forces, the walls, a piston
     and inelastic collisions (negative: taken)."""
     return float(tally.forces[0] + tally.heat.sum())
+
+
+def _total(particles: Particles, vessel: Vessel, field: ForceField) -> float:
+    """The total energy of the particles as they are, J."""
+    return sums.kinetic_energy(particles.mass, particles.velocity) + field.potential(
+        particles, vessel
+    )
 
 
 def _squared_rate(particles: Particles, vessel: Vessel, field: ForceField, total: float) -> float:
@@ -864,12 +867,18 @@ class _Shown:
 
     @classmethod
     def show(
-        cls, particles: Particles, vessel: Vessel, field: ForceField, substep: float
+        cls,
+        particles: Particles,
+        vessel: Vessel,
+        field: ForceField,
+        substep: float,
+        made_with: _MadeWith | None,
     ) -> _Shown:
         """Keep the particles' state as the integrator's own and put the processed state of
-        substeps ``substep`` (s) in its place."""
+        substeps ``substep`` (s) in its place, a processing ``made_with`` the forces, vessel and
+        particles of the step before (`matches` checked them)."""
         own = cls(particles.position.copy(), particles.velocity.copy(), np.empty(0), np.empty(0),
-                  field.saved(), _made_with(particles, vessel, field))  # fmt: skip
+                  field.saved(), made_with)  # fmt: skip
         _process(particles, vessel, field, field.acceleration, processing.SHARE * substep**2)
         own.shown_position = particles.position.copy()
         own.shown_velocity = particles.velocity.copy()

@@ -230,8 +230,9 @@ def smooth_intervals(
     start = np.empty((3, n, 2))
     sources = work[3:12]
     energy, virial = _energies(position, coupling, softening2, uniform, sources)
-    shown = np.empty((3, n, 2))  # the processed positions and velocities, the curved velocities
-    guard = (np.arange(n), np.empty((3, n)), np.empty((6, n)))
+    m = n if shows else 0  # the processing's work arrays, none where it records nothing
+    shown = np.empty((3, m, 2))  # the processed positions and velocities, the curved velocities
+    guard = (np.arange(m), np.empty((3, m)), np.empty((6, m)))
     vessel = (shape, limits[0], limits[1], limits[2], segments)
     for k in range(count):
         now = origin + (elapsed + k) * dt
