@@ -13,7 +13,7 @@ import collidium as cd
 from collidium import integrators
 from collidium.errors import InputError, SimulationError
 from collidium.forces.base import ForceField
-from collidium.integrators import DEFAULT_TOLERANCE
+from collidium.integrators import DEFAULT_TOLERANCE, AdaptiveLeapfrog
 from collidium.kernels import kick_timing, substeps
 from collidium.kernels.pairwise import PARALLEL_DIRECT_FROM as PARALLEL_ROWS
 from collidium.observers import EnergyDrift
@@ -333,6 +333,37 @@ def test_a_step_evaluates_the_forces_once_a_substep_also_when_taken_again(monkey
     assert retries  # some interval was taken again
 
 
+def test_the_python_substeps_read_the_rate_every_stride_and_at_the_interval_end(monkeypatch):
+    """Substeps taken in Python read the rate every `rate_stride` substeps (8 at the default
+    tolerance) and at the last, as the compiled ones do: a try of an interval that has enough
+    substeps reads it at those, one that has too few stops at the first read that needs more
+    (some before the interval's end)."""
+    sim = cd.load("charged-opposite", **{"forces.0.method": "tree"})  # substeps in Python
+    sim.run(steps=1)
+    rate, reads = integrators._squared_rate, []
+    monkeypatch.setattr(integrators, "_squared_rate", lambda *args: reads.append(1) or rate(*args))
+    interval, tries = AdaptiveLeapfrog._interval, []
+
+    def counted(self, *args):
+        before, n, dt = len(reads), args[-3], args[-5]
+        fastest, met = interval(self, *args)
+        tries.append((n, len(reads) - before, self.needed(fastest, dt) <= n))
+        return fastest, met
+
+    monkeypatch.setattr(AdaptiveLeapfrog, "_interval", counted)
+    stride = substeps.rate_stride(sim._integrator.tolerance)
+    assert stride == 8
+    sim.run(steps=300)
+    early = 0
+    for n, read, enough in tries:
+        every = sum(s % stride == 0 or s == n for s in range(1, n + 1))
+        assert read == every if enough else 1 <= read <= every
+        early += read < every
+    counts = {n for n, _, enough in tries if enough}
+    assert min(counts) < stride < max(counts)  # intervals read at their end alone, and inside
+    assert early > 0
+
+
 def test_integrator_and_tolerance_can_change_between_runs():
     sim = cd.load("orbit")
     sim.integrator = "fixed"
@@ -384,7 +415,7 @@ def test_compiled_substeps_give_the_python_run_to_round_off(monkeypatch, name, t
 
     def counting(*args):
         out = kernel(*args)
-        taken.append(out[0] - args[-7])  # substeps flown: the one reached less the first
+        taken.append(out[0] - args[-9])  # substeps flown: the one reached less the first
         return out
 
     def counting_intervals(*args):

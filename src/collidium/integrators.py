@@ -494,27 +494,34 @@ class AdaptiveLeapfrog(Integrator):
     ) -> tuple[float, bool]:
         """Take the interval in ``n`` regular substeps, those the compiled ``flight`` takes by
         it where there is one (`_SmoothFlight.substeps`), the rest in Python (`_substep`).
-        Returns the largest squared rate (1/s^2) met at their boundaries, starting from
-        ``fastest``, the interval's start's (`_squared_rate`, with the ``total`` energy J at the
-        start and the energy given since: by the velocity forces, the walls, a piston and
-        inelastic collisions); and whether a substep taken in Python met a contact."""
+        Returns the largest squared rate (1/s^2) met at the boundaries that read it
+        (`collidium.kernels.substeps.reads_rate`), starting from ``fastest``, the interval's
+        start's (`_squared_rate`, with the ``total`` energy J at the start and the energy given
+        since: by the velocity forces, the walls, a piston and inelastic collisions), up to the
+        first that needs more than ``n`` substeps, where the interval stops; and whether a
+        substep taken in Python met a contact."""
         t = now
         met = False
         given = _given(tally)
+        stride = substeps.rate_stride(self.tolerance)
         s = 1
         while s <= n:
             if flight is not None:  # as many substeps as it takes, compiled
                 now_total = total + (_given(tally) - given)
                 s, t, fastest, drag = flight.substeps(particles, field, tally, now, dt, s, n, t,
-                                                      fastest, now_total)  # fmt: skip
+                                                      fastest, now_total,
+                                                      self.tolerance)  # fmt: skip
                 tally.forces[0] += drag
                 if s > n:
                     break
             end = now + dt * s / n
             met |= self._substep(particles, vessel, field, drift, t, end, tally, s == n)
             t = end
-            now_total = total + (_given(tally) - given)
-            fastest = max(fastest, _squared_rate(particles, vessel, field, now_total))
+            if substeps.reads_rate(s, n, stride):
+                now_total = total + (_given(tally) - given)
+                fastest = max(fastest, _squared_rate(particles, vessel, field, now_total))
+                if self.needed(fastest, dt) > n:  # taken again with more
+                    break
             s += 1
         # Where the compiled substeps take contacts, Python takes only what they leave.
         return fastest, met and (flight is None or not flight.takes_contacts)
@@ -780,7 +787,8 @@ class _SmoothFlight:
         self, particles: Particles, field: ForceField, tally: Tally, total: float
     ) -> float:
         """`_squared_rate` of the current state, compiled (the same to round-off)."""
-        _, _, rate2, _ = self.substeps(particles, field, tally, 0.0, 0.0, 1, 0, 0.0, -1.0, total)
+        _, _, rate2, _ = self.substeps(particles, field, tally, 0.0, 0.0, 1, 0, 0.0, -1.0, total,
+                                       math.inf)  # fmt: skip
         return rate2
 
     def substeps(
@@ -795,16 +803,18 @@ class _SmoothFlight:
         t: float,
         fastest: float,
         total: float,
+        tolerance: float,
     ) -> tuple[int, float, float, float]:
         """Regular substeps from ``first`` of ``count`` up to the first left to Python
-        (`collidium.kernels.substeps.smooth_substeps`, given the ``total`` energy J; their
-        contacts added to the ``tally``): ``(that substep, its start in s, the largest squared
-        rate, the energy the drag gave in J)``. The field's acceleration is kept current; its
-        energies are summed again when read."""
+        (`collidium.kernels.substeps.smooth_substeps`, given the ``total`` energy J and the
+        integrator's ``tolerance``; their contacts added to the ``tally``): ``(that substep, its
+        start in s, the largest squared rate, the energy the drag gave in J)``; the substep is
+        past ``count`` also where the rate needs more substeps. The field's acceleration is kept
+        current; its energies are summed again when read."""
         s, reached, rate2, drag, processed, drifts = substeps.smooth_substeps(
             particles.position, particles.velocity, field.acceleration, self.mass, self.radius,
-            *self._forces, *self.walls, now, dt, first, count, t,
-            fastest, total, TOTAL_ENERGY_FLOOR, self._contacts(particles, tally),
+            *self._forces, *self.walls, now, dt, first, count, t, fastest, total,
+            TOTAL_ENERGY_FLOOR, tolerance, MAX_SUBSTEPS, self._contacts(particles, tally),
         )  # fmt: skip
         self._took(processed, drifts)
         return int(s), float(reached), float(rate2), float(drag)

@@ -150,6 +150,22 @@ def test_forces_alone_are_bitwise_those_summed_with_the_energies(rng, n, periodi
         assert np.all(energy == 7.0) and np.all(virial == 7.0)
 
 
+@pytest.mark.parametrize("n", [5, 40, 200])  # a plain loop, one task, tasks on one thread
+def test_pair_sums_without_the_energies_sum_the_same_forces(rng, n):
+    """`pair_sums` told to leave the energies out (the compiled substeps but an interval's
+    last) gives the forces of the sums with them, to round-off (LLVM may split the two loops'
+    reductions differently), and zeros for the energies and virials."""
+    x, y = rng.uniform(-8, 8, n), rng.uniform(-8, 8, n)
+    q = rng.choice([-1.0, 1.0, 0.5], n)
+    buffer = np.empty(4 * n * pairwise.MOST_BLOCKS)
+    full, alone = np.full((4, n), np.nan), np.full((4, n), np.nan)
+    pairwise.pair_sums(x, y, q, 5.0, 0.01, 0.0, 0.0, False, True, full, buffer)
+    pairwise.pair_sums(x, y, q, 5.0, 0.01, 0.0, 0.0, False, False, alone, buffer)
+    scale = np.abs(full[:2]).max()
+    np.testing.assert_allclose(alone[:2], full[:2], rtol=1e-12, atol=1e-13 * scale)
+    assert np.all(full[2:] != 0.0) and np.all(alone[2:] == 0.0)
+
+
 def test_neutral_particles_feel_and_exert_nothing(rng):
     position = rng.uniform(-5, 5, (30, 2))
     charge = rng.choice([-1.0, 1.0], 30)

@@ -25,9 +25,10 @@ def no_engine() -> tuple[object, ...]:
             engine.log.count, np.zeros((1, 2), dtype=np.int64), *tally)  # fmt: skip
 
 
-def smooth_substeps(*arguments):
-    """`substeps.smooth_substeps` without an engine: ``(substep, time, fastest, given)``."""
-    return substeps.smooth_substeps(*arguments, no_engine())[:4]
+def smooth_substeps(*arguments, tolerance=math.inf):
+    """`substeps.smooth_substeps` without an engine: ``(substep, time, fastest, given)``; with
+    an infinite ``tolerance`` the rate is read at every substep and never stops them."""
+    return substeps.smooth_substeps(*arguments, tolerance, MOST, no_engine())[:4]
 
 
 def smooth_intervals(*arguments):
@@ -289,6 +290,36 @@ def three_bodies():
     return position, velocity, mass, np.full(3, 0.05), charge
 
 
+@pytest.mark.parametrize("tolerance", [1.0 / 64, 1.0 / 256])
+def test_substeps_read_the_rate_every_stride_and_stop_where_it_needs_more(tolerance):
+    """At a finite tolerance the rate is read every `rate_stride` substeps (2 and 8 here) and
+    at the last, as the twin reads it: too few substeps stop at the first read, which needs
+    more; enough go to the interval's end, the largest rate read the twin's."""
+    position, velocity, mass, radius, charge = three_bodies()
+    acceleration = accelerations(position, mass, charge, 5.0, 0.0)
+    total = kinetic_energy(mass, velocity) + energy(position, charge, 5.0, 0.0)
+    stride = substeps.rate_stride(tolerance)
+    assert stride == reference.rate_stride(tolerance) == (2 if tolerance > 0.01 else 8)
+    for count in (stride, 2048):
+        got = [a.copy() for a in (position, velocity, acceleration)]
+        want = [a.copy() for a in (position, velocity, acceleration)]
+        step, t, fastest, _ = smooth_substeps(*got, mass, radius, charge, 5.0, 0.0, *FREE, BOX,
+                                              5.0, 5.0, np.nan, NONE, 0.0, 0.5, 1, 4 * count,
+                                              0.0, -1.0, total, FLOOR,
+                                              tolerance=tolerance)  # fmt: skip
+        twin = reference.smooth_substeps(*want, mass, radius, charge, 5.0, 0.0, *FREE, BOX,
+                                         np.array([5.0, 5.0]), np.nan, NONE, 0.0, 0.5, 1,
+                                         4 * count, 0.0, -1.0, total, FLOOR, CONTACT_MARGIN,
+                                         tolerance, MOST)  # fmt: skip
+        enough = needed(fastest, 0.5, tolerance, MOST) <= 4 * count
+        assert enough == (count > stride)
+        assert step == twin[0] == 4 * count + 1
+        assert t == twin[1] == pytest.approx(0.5 if enough else 0.5 * stride / (4 * count))
+        np.testing.assert_allclose(fastest, twin[2], rtol=1e-12)
+        for ours, theirs in zip(got, want, strict=True):
+            np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-12)
+
+
 @pytest.mark.parametrize("count", [1, 40])
 def test_intervals_equal_their_twin(count):
     """Intervals of 0.05 s of two light charges circling a heavy one: the same intervals taken,
@@ -423,3 +454,52 @@ def test_needed_is_the_smallest_power_of_two_that_keeps_the_substep_within_the_t
     assert needed(rate2, 0.01, 0.001, MOST) == reference.needed(rate2, 0.01, 0.001, MOST)
     assert needed(rate2, 0.01, 0.001, MOST) == min(MOST, max(1, 2 ** math.ceil(math.log2(ratio))))
     assert needed(np.nan, 0.01, 0.001, MOST) == MOST
+
+
+def near_disks(position, velocity, radius, half, h):
+    """The disks whose straight paths over ``h`` s come within their contact distance of
+    another's or of a wall of a box of half sides ``half`` (m): all pairs, in NumPy."""
+    d = position[None, :, :] - position[:, None, :]
+    w = velocity[None, :, :] - velocity[:, None, :]
+    w2 = np.einsum("ijk,ijk->ij", w, w)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        along = np.clip(np.nan_to_num(-np.einsum("ijk,ijk->ij", d, w) / w2), 0.0, h)
+    closest = d + w * along[:, :, None]
+    sigma = radius[:, None] + radius[None, :]
+    meets = np.einsum("ijk,ijk->ij", closest, closest) <= sigma**2
+    np.fill_diagonal(meets, False)
+    reach = np.abs(position) + np.abs(velocity) * h + radius[:, None]
+    return meets.any(axis=1) | (reach >= half).any(axis=1)
+
+
+def test_a_contact_drift_searching_pairs_for_the_near_disks_alone_runs_the_same_bits():
+    """A substep's drift by the exact engine whose queue searches pairs only for the disks that
+    may meet a contact (`collidium.kernels.events.rebuild_near`) runs the same events, to the
+    bit, as one that searches for every disk: in the charged gas, over a drift in which a
+    tenth of the disks may meet contacts."""
+    import collidium as cd
+
+    sim = cd.load("charged-gas")
+    sim.run(steps=20)
+    p, flight = sim.particles, sim._integrator._flight
+    h = 0.02
+    half = 0.5 * np.asarray(sim.container.size)
+    near = near_disks(p.position, p.velocity, p.radius, half, h)
+    assert 10 < near.sum() < p.n / 2
+    runs = []
+    for searched in (np.ones(p.n, dtype=bool), near):
+        contacts = [
+            tuple(np.copy(a) for a in item) if isinstance(item, tuple) else np.copy(item)
+            for item in flight._contacts(p, sim.tally)
+        ]
+        position, kicked, flown = p.position.copy(), p.velocity.copy(), np.empty_like(p.position)
+        done = substeps._contact_drift(position, kicked, flight.radius, flight.mass,
+                                       sim._field.acceleration, 0.0, h, tuple(contacts),
+                                       searched, flown)  # fmt: skip
+        log, logged = contacts[4], contacts[5]
+        runs.append((done, flown, kicked, log[: logged[0]], contacts[7]))
+    full, pruned = runs
+    assert full[0] > 20 and full[3].shape[0] > 5  # events, contacts logged
+    assert full[0] == pruned[0]
+    for a, b in zip(full[1:], pruned[1:], strict=True):
+        np.testing.assert_array_equal(a, b)

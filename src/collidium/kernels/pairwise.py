@@ -168,14 +168,18 @@ def _blocks(m: int) -> tuple[int, int, int]:
 
 
 @numba.njit(cache=True, inline="always")  # compiled with each caller's flags
-def _row(i, lo, hi, x, y, q, coupling, softening2, width, height, periodic, sums) -> None:
+def _row(i, lo, hi, x, y, q, coupling, softening2, width, height, periodic, energies,
+         sums) -> None:  # fmt: skip
     """The pairs of particle i with particles ``lo`` to ``hi - 1``, added to both particles'
-    ``sums`` (4, m): force x, y, pair energy, ``r . F``; i's own in four running sums first.
+    ``sums`` (4, m): force x, y, and if ``energies`` pair energy and ``r . F``; i's own in
+    running sums first.
 
-    The energies are summed whether or not they are wanted: a loop without their sums on the j
-    side was a fifth faster, but the forces are then bitwise the same as this loop's only as
-    long as LLVM splits both loops' reductions alike, which LLVM 14 (numba 0.59) did not, and
-    watching a run (reading its energies) would have changed its bits.
+    A loop without the energies is a fifth faster, but its forces are bitwise the same as those
+    of the loop with them only as long as LLVM splits both loops' reductions alike, which LLVM
+    14 (numba 0.59) did not: where the energies are read (an observer's firing), they are
+    summed whether or not the step needs them, or watching a run would change its bits. The
+    compiled substeps leave them out where no reading depends on it
+    (`collidium.kernels.substeps`).
 
     The pair loops count with unsigned integers: a signed j could be negative, which numba
     wraps around, and LLVM would then gather the loads, four times slower."""
@@ -194,12 +198,13 @@ def _row(i, lo, hi, x, y, q, coupling, softening2, width, height, periodic, sums
         f, uij = inverse_distance_pair(r2, kqi * q[j], softening2)
         fx += f * dx
         fy += f * dy
-        u += uij
-        w += f * r2
         sums[0, j] -= f * dx
         sums[1, j] -= f * dy
-        sums[2, j] += uij
-        sums[3, j] += f * r2
+        if energies:  # the same every pass: LLVM takes it out of the loop
+            u += uij
+            w += f * r2
+            sums[2, j] += uij
+            sums[3, j] += f * r2
     sums[0, i] += fx
     sums[1, i] += fy
     sums[2, i] += u
@@ -207,14 +212,15 @@ def _row(i, lo, hi, x, y, q, coupling, softening2, width, height, periodic, sums
 
 
 @uncounted(fastmath=_FASTMATH, error_model="numpy")
-def _tile(first, second, size, x, y, q, coupling, softening2, width, height, periodic, sums):
+def _tile(first, second, size, x, y, q, coupling, softening2, width, height, periodic, energies,
+          sums):  # fmt: skip
     """The pairs of block ``first`` with block ``second`` (each pair of the block once when they
     are the same), added to both particles' ``sums`` (4, m) (`_row`); vectorised, the running
     sums in several lanes."""
     m = x.shape[0]
     for i in range(first * size, min(m, (first + 1) * size)):
         lo, hi = max(second * size, i + 1), min(m, (second + 1) * size)
-        _row(i, lo, hi, x, y, q, coupling, softening2, width, height, periodic, sums)
+        _row(i, lo, hi, x, y, q, coupling, softening2, width, height, periodic, energies, sums)
 
 
 #: Particles with a source up to which the pair sums take a plain loop (`_few`) instead of the
@@ -223,28 +229,31 @@ FEW = 8
 
 
 @uncounted(forceinline=True, fastmath={"contract"}, error_model="numpy")
-def _few(x, y, q, coupling, softening2, width, height, periodic, sums) -> None:
+def _few(x, y, q, coupling, softening2, width, height, periodic, energies, sums) -> None:
     """The pair sums of a few particles into ``sums`` (4, m), zeroed first: each pair once, in
     `_tile`'s order (`_row`), one pair at a time (no reassociation: LLVM makes no vectors of so
     short a loop)."""
     _zero(sums)
     m = x.shape[0]
     for i in range(m):
-        _row(i, i + 1, m, x, y, q, coupling, softening2, width, height, periodic, sums)
+        _row(i, i + 1, m, x, y, q, coupling, softening2, width, height, periodic, energies, sums)
 
 
 @uncounted(forceinline=True)
-def _one_task(blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums):
+def _one_task(blocks, size, x, y, q, coupling, softening2, width, height, periodic, energies,
+              sums):  # fmt: skip
     """The pair sums when they make one task, into ``sums`` itself: `_few` for up to `FEW`
     particles, else the task's tiles (`_task`)."""
     if x.shape[0] <= FEW:
-        _few(x, y, q, coupling, softening2, width, height, periodic, sums)
+        _few(x, y, q, coupling, softening2, width, height, periodic, energies, sums)
     else:
-        _task(0, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
+        _task(0, blocks, size, x, y, q, coupling, softening2, width, height, periodic, energies,
+              sums)  # fmt: skip
 
 
 @uncounted()
-def _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums) -> None:
+def _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, energies,
+          sums) -> None:  # fmt: skip
     """Task t of the pair sums: the tiles of block rows t and ``blocks - 1 - t`` (each tile of a
     row with itself and the blocks after it) into its own ``sums`` (4, m), zeroed first."""
     _zero(sums)
@@ -252,7 +261,7 @@ def _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodi
     for first in range(t, mirror + 1, max(1, mirror - t)):  # rows t and mirror (once if one)
         for second in range(first, blocks):
             _tile(first, second, size, x, y, q, coupling, softening2, width, height, periodic,
-                  sums)  # fmt: skip
+                  energies, sums)  # fmt: skip
 
 
 @numba.njit(cache=True, inline="always")
@@ -275,8 +284,10 @@ def _zero(sums) -> None:
 
 
 @uncounted(forceinline=True)  # into the substeps' loop: a call there cost a fifth
-def pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buffer) -> None:
-    """Every pair's force x, y, energy and ``r . F`` on both particles into ``sums`` (4, m),
+def pair_sums(x, y, q, coupling, softening2, width, height, periodic, energies, sums,
+              buffer) -> None:  # fmt: skip
+    """Every pair's force x, y, and if ``energies`` its energy and ``r . F`` (`_row`; else 0),
+    on both particles into ``sums`` (4, m),
     each pair once, on the calling thread: task by task, each in a buffer of its own, the
     buffers then added up in task order, as `direct_parallel` does on all threads, so both give
     the same bits.
@@ -287,6 +298,8 @@ def pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buff
         Contiguous coordinates (m) and sources of the particles with a source.
     coupling, softening2, width, height, periodic
         As in `inverse_distance_direct`.
+    energies : bool
+        Whether to sum the pair energies and ``r . F`` too.
     sums : ndarray, shape (4, m)
         Output: force x and y (N), the sum of the pair energies (J) and of ``r_ij . F_ij``.
     buffer : ndarray, shape (4 * m * tasks,) at least
@@ -296,11 +309,13 @@ def pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buff
     m = x.shape[0]
     size, blocks, tasks = _blocks(m)
     if tasks == 1:  # as `direct_parallel` does
-        _one_task(blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
+        _one_task(blocks, size, x, y, q, coupling, softening2, width, height, periodic, energies,
+                  sums)  # fmt: skip
         return
     buffers = buffer[: tasks * 4 * m].reshape((tasks, 4, m))
     for t in range(tasks):
-        _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, buffers[t])
+        _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, energies,
+              buffers[t])  # fmt: skip
     _total(buffers, sums)
 
 
@@ -329,11 +344,12 @@ def direct_parallel(position, source, coupling, softening2, width, height, perio
     size, blocks, tasks = _blocks(m)
     sums = np.empty((4, m))
     if tasks == 1:  # one task sums into ``sums`` itself, as in `pair_sums`
-        _one_task(blocks, size, x, y, q, coupling, softening2, width, height, periodic, sums)
+        _one_task(blocks, size, x, y, q, coupling, softening2, width, height, periodic, True,
+                  sums)  # fmt: skip
     else:
         buffers = np.empty((tasks, 4, m))
         for t in numba.prange(tasks):
-            _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic,
+            _task(t, blocks, size, x, y, q, coupling, softening2, width, height, periodic, True,
                   buffers[t])  # fmt: skip
         _total(buffers, sums)
     _scatter(sums, index, force, energy, virial, energies)
@@ -348,7 +364,7 @@ def direct_serial(position, source, coupling, softening2, width, height, periodi
     sums = np.empty((4, m))
     tasks = _blocks(m)[2]
     buffer = np.empty(4 * m * tasks if tasks > 1 else 0)  # one task sums into ``sums``
-    pair_sums(x, y, q, coupling, softening2, width, height, periodic, sums, buffer)
+    pair_sums(x, y, q, coupling, softening2, width, height, periodic, True, sums, buffer)
     _scatter(sums, index, force, energy, virial, energies)
 
 

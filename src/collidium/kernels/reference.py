@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from collidium.kernels.substeps import RATE_SPACING
 from collidium.kernels.vessels import BOX, CIRCLE, segments
 from collidium.state import FloatArray, IntArray
 
@@ -1174,6 +1175,8 @@ def smooth_substeps(
     total: float,
     energy_floor: float,
     margin: float,
+    tolerance: float = math.inf,
+    most: int = 2**30,
 ) -> tuple[int, float, float, float]:
     """Twin of `substeps.smooth_substeps` in a box of half sides ``half`` (``shape`` `BOX`), a
     circle of radius ``rim`` (`CIRCLE`) or neither, and against the segments of ``table``.
@@ -1182,10 +1185,14 @@ def smooth_substeps(
     ``fall``, if any); the contact test on all pairs and walls at once (contacts within
     ``margin`` of a radius, or of the substep); the straight flight; the force
     (`inverse_distance_direct` and the ``uniform`` field's, unless carried); the kick and the
-    flow; the squared rate from the ``total`` energy (`squared_rate`). Updates the motion in
-    place and returns ``(substep not taken, its start, fastest, energy the drag gave)``.
+    flow; at every `rate_stride` substeps and the last, the squared rate from the ``total``
+    energy (`squared_rate`), which stops the substeps once it needs more than ``count``
+    (`needed`; never with an infinite ``tolerance``, which reads it at every substep). Updates
+    the motion in place and returns ``(substep not taken, its start, fastest, energy the drag
+    gave)``.
     """
     zero = np.zeros(2)
+    stride = rate_stride(tolerance)
     given = 0.0
     carried = fall if fall.size else zero
     if fastest < 0.0:
@@ -1224,10 +1231,20 @@ def smooth_substeps(
         acceleration[...] = pull
         given += before + after
         t = end
-        rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, turn, damp,
-                             total + given, energy_floor)  # fmt: skip
-        fastest = max(fastest, rate2)
+        if s % stride == 0 or s == count:
+            rate2 = squared_rate(position, velocity, mass, source, coupling, softening2, turn,
+                                 damp, total + given, energy_floor)  # fmt: skip
+            fastest = max(fastest, rate2)
+            if needed(fastest, dt, tolerance, most) > count:
+                break
     return count + 1, t, fastest, given
+
+
+def rate_stride(tolerance: float) -> int:
+    """Twin of `substeps.rate_stride`: the largest power of two n with ``n tolerance <=
+    RATE_SPACING``, at least 1."""
+    ratio = RATE_SPACING / tolerance
+    return 1 if ratio < 2.0 else 2 ** math.floor(math.log2(ratio))
 
 
 def flowed(
@@ -1358,7 +1375,7 @@ def smooth_intervals(
             reached, _, fastest, drag = smooth_substeps(
                 position, velocity, acceleration, mass, radius, source, coupling, softening2,
                 uniform, fall, turn, region, damp, shape, half, rim, table, now, dt, 1, taken,
-                now, rate2, total, energy_floor, margin,
+                now, rate2, total, energy_floor, margin, tolerance, most,
             )  # fmt: skip
             met = reached <= taken
             required = needed(fastest, dt, tolerance, most)

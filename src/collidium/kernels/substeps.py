@@ -55,6 +55,12 @@ RECORD = ("kinetic", "potential", "virial", "px", "py", "total_speed")
 #: cell crossing), so round-off could otherwise part the two on a grazing contact.
 CONTACT_MARGIN = 1e-6
 
+#: The substeps read their rate every `rate_stride` substeps and at each interval's end, a
+#: stride being at most this fraction of the fastest time scale (``tolerance`` of it a
+#: substep): the rate changes by a few percent over it, while each read is a sum over the
+#: pairs that costs half a force evaluation.
+RATE_SPACING = 1.0 / 32.0
+
 
 @uncounted()
 def energy_scale(kinetic: float, total: float, floor: float) -> float:
@@ -68,7 +74,7 @@ def energy_scale(kinetic: float, total: float, floor: float) -> float:
 def smooth_substeps(
     position, velocity, acceleration, mass, radius, source, coupling, softening2, uniform, fall,
     turn, region, damp, shape, half_width, half_height, rim, segments, now, dt, first, count, t,
-    fastest, total, energy_floor, contacts,
+    fastest, total, energy_floor, tolerance, most, contacts,
 ) -> tuple[int, float, float, float, int, int]:  # fmt: skip
     """Regular substeps ``first, first + 1, ...`` of ``count`` in the interval from ``now`` of
     ``dt`` (s), in place, up to the first that may meet a contact and that the exact engine
@@ -77,10 +83,11 @@ def smooth_substeps(
     Substep s ends at ``now + dt s / count``; it is the velocity forces' flow for ``h / 2``
     (`_flowed`: the drag, the magnetic field's turn), a kick ``v += a h / 2``, the straight flight
     over h, the accelerations at the new positions, the kick ``v += a h / 2`` and the flow for
-    ``h / 2``. After each, the squared rate of the forces weighted by energy
-    (`collidium.integrators._squared_rate`) raises ``fastest``. No energy is summed: the rate's
-    energy scale takes the potential as the total energy less the kinetic, the total as
-    ``total`` and what the drag gave since.
+    ``h / 2``. After each that `reads_rate`, the squared rate of the forces weighted by energy
+    (`collidium.integrators._squared_rate`) raises ``fastest``, and once that needs more than
+    ``count`` substeps (`needed`) the interval stops there, to be taken again with more. No
+    energy is summed: the rate's energy scale takes the potential as the total energy less the
+    kinetic, the total as ``total`` and what the drag gave since.
 
     Parameters
     ----------
@@ -121,6 +128,9 @@ def smooth_substeps(
     energy_floor : float
         The rate's energy scale is ``|KE + U|`` but at least ``(KE + |U|) / energy_floor``
         (`energy_scale`).
+    tolerance, most
+        The integrator's accuracy parameter and most substeps (`needed`): which boundaries read
+        the rate (`reads_rate`), and whether it needs more substeps than ``count``.
     contacts : tuple
         The exact engine for the substeps that meet contacts (`_contact_drift`): its queue's
         arrays, the wall table, the events between re-sorts, the runaway reach (m), the contact
@@ -132,16 +142,17 @@ def smooth_substeps(
     -------
     tuple
         ``(substep, time, fastest, given, events, drifts)``: the substep not taken
-        (``count + 1`` when all were), its start (s), the largest squared rate, the energy the
-        drag gave in the substeps taken (J, negative), and the events the engine processed in
-        the drifts it took.
+        (``count + 1`` when all were, or when the rate needs more substeps), its start (s), the
+        largest squared rate, the energy the drag gave in the substeps taken (J, negative), and
+        the events the engine processed in the drifts it took.
     """
     work = _work(mass, source, coupling, softening2, contacts[-3:])
     walls = (shape, half_width, half_height, rim, segments)
     external = (uniform, fall, turn, region, damp)
+    accuracy = (tolerance, most, energy_floor)
     return _substeps(position, velocity, acceleration, mass, radius, coupling, softening2,
-                     external, walls, now, dt, first, count, t, fastest, total, energy_floor,
-                     work, contacts)  # fmt: skip
+                     external, walls, now, dt, first, count, t, fastest, total, accuracy, work,
+                     contacts)[:6]  # fmt: skip
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -158,10 +169,12 @@ def smooth_intervals(
 
     Interval k starts at ``origin + (elapsed + k) dt``, the simulation's clock. Its substep count
     is the larger of ``substeps`` and the fewest the rate at its start needs (`needed`); it is
-    taken again with more if a substep boundary needs more, and the count the next interval
-    starts from is this one, or half of it when half would have done. Where its substep differs
-    from the one before, and ``keep``, the velocities are first scaled so that the substeps'
-    modified energy goes on (`collidium.kernels.modified_energy.keep_across_step`).
+    taken again with more if a boundary that reads the rate needs more (`reads_rate`), and the
+    count the next interval starts from is this one, or half of it when half would have done.
+    The rate at an interval's end is the next one's start's: its pair sum is read once. Where
+    its substep differs from the one before, and ``keep``, the velocities are first scaled so
+    that the substeps' modified energy goes on
+    (`collidium.kernels.modified_energy.keep_across_step`).
 
     Parameters
     ----------
@@ -230,6 +243,8 @@ def smooth_intervals(
     start = np.empty((3, n, 2))
     sources = work[3:12]
     energy, virial = _energies(position, coupling, softening2, uniform, sources)
+    stiffness = -1.0  # none read yet: the pair sum of the state reached, once read
+    accuracy = (tolerance, most_substeps, energy_floor)
     m = n if shows else 0  # the processing's work arrays, none where it records nothing
     shown = np.empty((3, m, 2))  # the processed positions and velocities, the curved velocities
     guard = (np.arange(m), np.empty((3, m)), np.empty((6, m)))
@@ -237,8 +252,9 @@ def smooth_intervals(
     for k in range(count):
         now = origin + (elapsed + k) * dt
         total = kinetic_energy(mass, velocity) + energy
-        rate2 = _squared_rate(position, velocity, mass, coupling, softening2, flows2, total,
-                              energy_floor, sources, work[21:23])  # fmt: skip
+        if stiffness < 0.0:
+            stiffness = _stiffness(position, velocity, coupling, softening2, sources, work[21:23])
+        rate2 = _scaled_rate(stiffness, mass, velocity, total, energy_floor, flows2)
         if not dt * math.sqrt(rate2) <= most_substeps * tolerance:  # also NaN
             return k, substeps, substep, processed, drifts
         taken = max(substeps, needed(rate2, dt, tolerance, most_substeps))
@@ -248,9 +264,9 @@ def smooth_intervals(
             if keep and substep == substep and dt / taken != substep:  # NaN: none before
                 _keep_modified_energy(position, velocity, acceleration, mass, work, substep,
                                       dt / taken, tolerance)  # fmt: skip
-            s, _, fastest, drag, done, drifted = _substeps(
+            s, _, fastest, drag, done, drifted, reached = _substeps(
                 position, velocity, acceleration, mass, radius, coupling, softening2, external,
-                walls, now, dt, 1, taken, now, rate2, total, energy_floor, work, contacts,
+                walls, now, dt, 1, taken, now, rate2, total, accuracy, work, contacts,
             )  # fmt: skip
             if s <= taken:  # a contact left to Python, or a value not finite
                 _restore(position, velocity, acceleration, start)
@@ -266,6 +282,7 @@ def smooth_intervals(
             taken = max(required, 2 * taken)
         substeps = max(1, taken // 2) if required <= taken // 2 else taken
         substep = dt / taken
+        stiffness = reached
         given += drag
         heat[k] = given
         # The last substep's pair sums are of the positions now.
@@ -321,7 +338,7 @@ def _keep_modified_energy(position, velocity, acceleration, mass, work, substep,
                      0.0, 0.0, False, work[23], substep, following, limit)  # fmt: skip
 
 
-@numba.njit(cache=True)
+@uncounted()
 def needed(rate2: float, dt: float, tolerance: float, most: int) -> int:
     """The fewest substeps, a power of two up to ``most``, that keep ``dt / n`` (s) within
     ``tolerance`` times the time scale ``1 / sqrt(rate2)`` (``rate2`` in 1/s^2)."""
@@ -334,16 +351,34 @@ def needed(rate2: float, dt: float, tolerance: float, most: int) -> int:
     return 1 << (exponent - 1 if mantissa == 0.5 else exponent)
 
 
+@uncounted()
+def rate_stride(tolerance: float) -> int:
+    """The substeps between reads of the rate: the largest power of two whose substeps span at
+    most `RATE_SPACING` of the fastest time scale, each ``tolerance`` of it; at least 1."""
+    stride = 1
+    while 2 * stride * tolerance <= RATE_SPACING:
+        stride *= 2
+    return stride
+
+
+@uncounted()
+def reads_rate(s: int, count: int, stride: int) -> bool:
+    """Whether the end of substep ``s`` (1 to ``count``) reads the rate: every ``stride``
+    substeps (`rate_stride`) and at the interval's end."""
+    return s % stride == 0 or s == count
+
+
 @numba.njit(cache=True, error_model="numpy")
 def _work(mass, source, coupling, softening2, tally):
     """What `_substeps` works in, for N particles of which m have a source: kicked, flown and
     pulled motions (N, 2); the indices, sources and inverse masses of those m; rows for their
     coordinates and velocities (m,) each, their pair sums (4, m) and the sums' buffer; the
-    sweep's order and interval ends (N,) (`_meets_contact`); the pair force's law as
+    sweep's order and interval ends (N,) (`_contacts_ahead`); the pair force's law as
     `collidium.kernels.kick_timing.correct` takes it (sources (1, N), coupling and squared
     softening (1,)); a copy of the ``tally``'s counts, impulses and heat, to put back; the
     order and rows of `collidium.kernels.pairwise.pruned_stiffness` (m,) and (6, m); the rows
-    of `collidium.kernels.modified_energy.keep_across_step` (4, N)."""
+    of `collidium.kernels.modified_energy.keep_across_step` (4, N); the disks that may meet a
+    contact in a substep (N,) (`_contacts_ahead`)."""
     n = mass.shape[0]
     m = 0
     for i in range(n):
@@ -364,23 +399,26 @@ def _work(mass, source, coupling, softening2, tally):
     kept = (tally[0].copy(), tally[1].copy(), tally[2].copy())
     pruning = (np.arange(m), np.empty((6, m)))
     gathered = (np.empty((4, n)),)
+    near = (np.zeros(n, dtype=np.bool_),)
     # Concatenated: numba builds an unpacked (*a, *b) through a list, which holds one type.
     return (motion + (index, charged, inverse_mass) + rows + sums + sweep + law  # noqa: RUF005
-            + kept + pruning + gathered)  # fmt: skip
+            + kept + pruning + gathered + near)  # fmt: skip
 
 
 @uncounted(error_model="numpy")
 def _substeps(position, velocity, acceleration, mass, radius, coupling, softening2, external,
-              walls, now, dt, first, count, t, fastest, total, energy_floor, work,
+              walls, now, dt, first, count, t, fastest, total, accuracy, work,
               contacts):  # fmt: skip
     """`smooth_substeps` in its work arrays (`_work`), the uniform field and the velocity
-    forces as one tuple (``uniform, fall, turn, region, damp``), the vessel as another.
+    forces as one tuple (``uniform, fall, turn, region, damp``), the vessel as another, the
+    tolerance, most substeps and energy floor as a third. Returns `smooth_substeps`'s tuple and
+    the pair sum of the rate (`_stiffness`) at the interval's end, -1 where it was not reached.
 
     Compiled without reference counting (`uncounted`), as are the pair sums it calls: the
     atomic counts numba puts around array arguments were 0.35 us of a two-body substep's
     0.6 us."""
     kicked, flown, pull = work[:3]
-    index, charged, inverse_mass, x, y, vx, vy, sums, buffer = work[3:12]
+    index, charged, _, x, y, _, _, sums, buffer = work[3:12]
     order, low, high = work[12:15]
     law = work[15:18]
     uniform, fall, turn, region, damp = external
@@ -388,14 +426,17 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     tally = contacts[-3:]
     kept = work[18:21]
     order_x, rows_x = work[21:23]
+    near = work[24]
     engine = contacts[2] > 0  # events between re-sorts: 0 for no engine
+    tolerance, most, energy_floor = accuracy
+    stride = rate_stride(tolerance)
     n = position.shape[0]
     given = 0.0
     processed = drifts = 0
     flows2 = _flows2(turn, damp)
     if fastest < 0.0:
-        fastest = _squared_rate(position, velocity, mass, coupling, softening2, flows2, total,
-                                energy_floor, work[3:12], work[21:23])  # fmt: skip
+        stiffness = _stiffness(position, velocity, coupling, softening2, work[3:12], work[21:23])
+        fastest = _scaled_rate(stiffness, mass, velocity, total, energy_floor, flows2)
     for s in range(first, count + 1):
         end = now + dt * s / count
         h = end - t
@@ -407,28 +448,30 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
             kicked[i, 1] = _kicked(wy, acceleration[i, 1], fall, 1, 0.5 * h)
             before += heat
         if not _finite(kicked):
-            return s, t, fastest, given, processed, drifts
-        meets = _meets_contact(position, kicked, radius, h, walls, order, low, high)
+            return s, t, fastest, given, processed, drifts, -1.0
+        meets = _contacts_ahead(position, kicked, radius, h, walls, order, low, high, near)
         if meets:  # the exact engine takes the drift, if it may
             if not engine:
-                return s, t, fastest, given, processed, drifts
+                return s, t, fastest, given, processed, drifts, -1.0
             _keep_tally(tally, kept)
             done = _contact_drift(position, kicked, radius, mass, acceleration, t, h, contacts,
-                                  flown)  # fmt: skip
+                                  near, flown)  # fmt: skip
             if done < 0:
                 _keep_tally(kept, tally)
-                return s, t, fastest, given, processed, drifts
+                return s, t, fastest, given, processed, drifts, -1.0
         else:
             done = 0
             for i in range(n):
                 for d in range(2):
                     flown[i, d] = position[i, d] + kicked[i, d] * h
+        # The energies only where an interval ends (`smooth_intervals` reads them there): a
+        # fifth of the pair sum's time (`collidium.kernels.pairwise._row`).
         _accelerations(flown, mass, coupling, softening2, uniform, fall, index, charged, x, y,
-                       sums, buffer, pull)  # fmt: skip
+                       s == count, sums, buffer, pull)  # fmt: skip
         if not _finite(pull):
             if meets:
                 _keep_tally(kept, tally)
-            return s, t, fastest, given, processed, drifts
+            return s, t, fastest, given, processed, drifts, -1.0
         if meets:
             kick_timing.correct(log, logged[0], t, h, position, flown, acceleration, pull,
                                 kicked, mass, law[0], law[1], law[2], 0.0, 0.0, False,
@@ -447,19 +490,25 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
             after += heat
         given += before + after
         t = end
-        rate2 = _rate(position, velocity, mass, coupling, softening2, flows2, total + given,
-                      energy_floor, index, charged, inverse_mass, x, y, vx, vy, order_x,
-                      rows_x)  # fmt: skip
-        if rate2 > fastest:
-            fastest = rate2
-    return count + 1, t, fastest, given, processed, drifts
+        if reads_rate(s, count, stride):
+            stiffness = _stiffness(position, velocity, coupling, softening2, work[3:12],
+                                   (order_x, rows_x))  # fmt: skip
+            fastest = max(fastest, _scaled_rate(stiffness, mass, velocity, total + given,
+                                                energy_floor, flows2))  # fmt: skip
+            if s == count:
+                return count + 1, t, fastest, given, processed, drifts, stiffness
+            if needed(fastest, dt, tolerance, most) > count:  # taken again with more
+                return count + 1, t, fastest, given, processed, drifts, -1.0
+    return count + 1, t, fastest, given, processed, drifts, -1.0
 
 
 @uncounted(error_model="numpy")
-def _contact_drift(position, kicked, radius, mass, acceleration, t, h, contacts, flown) -> int:
+def _contact_drift(position, kicked, radius, mass, acceleration, t, h, contacts, near,
+                   flown) -> int:  # fmt: skip
     """The drift of a substep that meets contacts, by the exact engine, as
     `collidium.collisions.ExactCollisions.drift` takes it: the queue built afresh from the
-    positions at ``t`` (s) and the ``kicked`` velocities, run to ``t + h`` with the kick timing
+    positions at ``t`` (s) and the ``kicked`` velocities (the pairs searched for the ``near``
+    disks alone, `collidium.kernels.events.rebuild_near`), run to ``t + h`` with the kick timing
     of ``acceleration`` and the contacts logged, the positions and velocities at the end written
     to ``flown`` and ``kicked``. Returns the events processed, or -1 where the integrator must
     take the substep (a runaway speed, time stuck, more contacts than the log holds); the
@@ -469,7 +518,8 @@ def _contact_drift(position, kicked, radius, mass, acceleration, t, h, contacts,
     if not largest_magnitude(kicked) * h <= reach:  # also NaN
         return -1
     events.load(position, kicked, radius, mass, body, event)
-    events.rebuild(t, body, geometry, grid, head, next_, event, keys, items, segments, piston)
+    events.rebuild_near(t, body, geometry, grid, head, next_, event, keys, items, segments,
+                        piston, near)  # fmt: skip
     logged[0] = 0
     done = events.run_events(t + h, body, image, geometry, grid, head, next_, event, keys, items,
                              counts, impulse, acceleration, t + 0.5 * h, sort_every, log,
@@ -528,25 +578,26 @@ def _finite(values: np.ndarray) -> bool:
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffer) -> None:
+def _pair_sums(position, coupling, softening2, index, charged, x, y, energies, sums,
+               buffer) -> None:  # fmt: skip
     """The pair sums (4, m) into ``sums`` of the m particles with a source (``index``, sources
     ``charged``) at ``position`` (N, 2) (`collidium.kernels.pairwise.pair_sums`, as
-    `collidium.kernels.pairwise.inverse_distance_direct` takes them), their coordinates
-    gathered into ``x`` and ``y``."""
+    `collidium.kernels.pairwise.inverse_distance_direct` takes them; the energies only if
+    ``energies``), their coordinates gathered into ``x`` and ``y``."""
     for c in range(index.shape[0]):
         x[c] = position[index[c], 0]
         y[c] = position[index[c], 1]
-    pair_sums(x, y, charged, coupling, softening2, 0.0, 0.0, False, sums, buffer)
+    pair_sums(x, y, charged, coupling, softening2, 0.0, 0.0, False, energies, sums, buffer)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
 def _accelerations(position, mass, coupling, softening2, uniform, fall, index, charged, x, y,
-                   sums, buffer, out) -> None:  # fmt: skip
+                   energies, sums, buffer, out) -> None:  # fmt: skip
     """The accelerations (N, 2) of the pair force and the ``uniform`` field's forces (N, 2), or
     (0, 2) without one; not where the drift carries it, ``fall`` not empty) into ``out``: the
     forces over the masses, as `collidium.forces.base.ForceField.evaluate` forms them
-    (`_pair_sums`)."""
-    _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffer)
+    (`_pair_sums`, its energies too if ``energies``)."""
+    _pair_sums(position, coupling, softening2, index, charged, x, y, energies, sums, buffer)
     for i in range(position.shape[0]):  # loops: an array expression costs more than 3 bodies
         out[i, 0] = 0.0
         out[i, 1] = 0.0
@@ -567,7 +618,7 @@ def _energies(position, coupling, softening2, uniform, sources) -> tuple[float, 
     pair sums taken here. ``sources``: the arrays of `_work` from the indices to the sums'
     buffer."""
     index, charged, _, x, y, _, _, sums, buffer = sources
-    _pair_sums(position, coupling, softening2, index, charged, x, y, sums, buffer)
+    _pair_sums(position, coupling, softening2, index, charged, x, y, True, sums, buffer)
     return _summed_energies(position, uniform, sums)
 
 
@@ -590,34 +641,29 @@ def _summed_energies(position, uniform, sums) -> tuple[float, float]:
     return 0.0 + energy + field, 0.0 + virial  # the field adds its forces' sums to 0
 
 
-@uncounted(error_model="numpy")
-def _squared_rate(position, velocity, mass, coupling, softening2, flows2, total, floor,
-                  sources, pruning) -> float:  # fmt: skip
-    """`_rate` with the arrays of `_work` from the indices to the sums' buffer (``sources``)
-    and the pruning's order and rows (``pruning``)."""
+@uncounted(error_model="numpy")  # that of the inlined rows
+def _stiffness(position, velocity, coupling, softening2, sources, pruning) -> float:
+    """The squared rate's pair sum, ``(|U_ij| rate_ij^2)^2`` at its largest, J^2/s^4
+    (`collidium.kernels.pairwise.pruned_stiffness`), of the particles with a source (``sources``:
+    the arrays of `_work` from the indices to the sums' buffer), gathered into its rows, in the
+    ``order`` of x kept from call to call (``pruning``: the order and the pruning's rows)."""
     index, charged, inverse_mass, x, y, vx, vy, _, _ = sources
     order, rows = pruning
-    return _rate(position, velocity, mass, coupling, softening2, flows2, total, floor, index,
-                 charged, inverse_mass, x, y, vx, vy, order, rows)  # fmt: skip
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")  # that of the inlined rows
-def _rate(position, velocity, mass, coupling, softening2, flows2, total, floor, index,
-          charged, inverse_mass, x, y, vx, vy, order, rows) -> float:  # fmt: skip
-    """`collidium.integrators._squared_rate`, 1/s^2, given the total energy (J): the square
-    root of the largest ``(|U_ij| rate_ij^2)^2`` over pairs
-    (`collidium.kernels.pairwise.pruned_stiffness`, from the particles with a source ``index``
-    gathered into ``x, y, vx, vy``, in the ``order`` of x kept from call to call) over the
-    energy scale, or ``flows2``, the velocity forces' (`_flows2`), whichever is larger."""
     for c in range(index.shape[0]):
         i = index[c]
         x[c], y[c] = position[i, 0], position[i, 1]
         vx[c], vy[c] = velocity[i, 0], velocity[i, 1]
     if index.shape[0] < PRUNE_FROM:  # no call for a few bodies: a tenth of their substep
-        stiffness = every_row(x, y, vx, vy, charged, inverse_mass, coupling, softening2)
-    else:
-        stiffness = pruned_stiffness(x, y, vx, vy, charged, inverse_mass, coupling, softening2,
-                                     order, rows)  # fmt: skip
+        return every_row(x, y, vx, vy, charged, inverse_mass, coupling, softening2)
+    return pruned_stiffness(x, y, vx, vy, charged, inverse_mass, coupling, softening2, order,
+                            rows)  # fmt: skip
+
+
+@numba.njit(cache=True, inline="always")
+def _scaled_rate(stiffness, mass, velocity, total, floor, flows2) -> float:
+    """`collidium.integrators._squared_rate`, 1/s^2, of a pair sum ``stiffness``
+    (`_stiffness`), given the total energy (J): its square root over the energy scale
+    (`energy_scale`), or ``flows2``, the velocity forces' (`_flows2`), whichever is larger."""
     scale = energy_scale(kinetic_energy(mass, velocity), total, floor)
     energy = math.sqrt(stiffness) / scale if scale > 0.0 else 0.0
     return max(energy, flows2)
@@ -659,9 +705,10 @@ def _flowed(i, vx, vy, position, mass, turn, region, damp, lag) -> tuple[float, 
 
 
 @numba.njit(cache=True, inline="always")
-def _meets_contact(position, velocity, radius, lag, walls, order, low, high) -> bool:
+def _contacts_ahead(position, velocity, radius, lag, walls, order, low, high, near) -> bool:
     """Whether a straight flight of ``lag`` seconds may bring a disk to a wall or another disk
-    (within `CONTACT_MARGIN`).
+    (within `CONTACT_MARGIN`), and which: ``near`` (N,) gets True for those, False for the
+    others.
 
     Pairs are swept and pruned along x: ``low`` and ``high`` (N,) get the x-interval each disk
     sweeps, and ``order`` (N,) lists the disks by its low end, kept from the last call (a nearly
@@ -670,6 +717,9 @@ def _meets_contact(position, velocity, radius, lag, walls, order, low, high) -> 
     n = position.shape[0]
     shape, half_width, half_height, rim, segments = walls
     horizon = lag * (1.0 + CONTACT_MARGIN)
+    meets = False
+    for i in range(n):
+        near[i] = False
     for i in range(n):
         x, y, vx, vy = position[i, 0], position[i, 1], velocity[i, 0], velocity[i, 1]
         wide = radius[i] * (1.0 + CONTACT_MARGIN)
@@ -679,7 +729,7 @@ def _meets_contact(position, velocity, radius, lag, walls, order, low, high) -> 
         delay, _ = contacts.earliest(x, y, vx, vy, wide, shape, half_width, half_height, rim,
                                      segments)  # fmt: skip
         if delay <= horizon:
-            return True
+            near[i] = meets = True
     for i in range(n):
         reach = radius[i] * (1.0 + 2.0 * CONTACT_MARGIN)  # wider than the test: never prunes a hit
         x, travel = position[i, 0], velocity[i, 0] * horizon
@@ -694,8 +744,8 @@ def _meets_contact(position, velocity, radius, lag, walls, order, low, high) -> 
                 break
             sigma = (radius[i] + radius[j]) * (1.0 + CONTACT_MARGIN)
             if sigma > 0.0 and _closest(position, velocity, i, j, horizon) <= sigma * sigma:
-                return True
-    return False
+                near[i] = near[j] = meets = True
+    return meets
 
 
 #: The relative slack of `_clear_of_shape`, far above the round-off of its sums.
