@@ -503,3 +503,42 @@ def test_a_contact_drift_searching_pairs_for_the_near_disks_alone_runs_the_same_
     assert full[0] == pruned[0]
     for a, b in zip(full[1:], pruned[1:], strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("vessel", ["box", "circle"])
+def test_a_flight_that_stays_in_the_disks_rooms_meets_no_contact(rng, vessel):
+    """Each disk's room (`substeps._rooms`, kept from the last contact test that found none)
+    lets the substeps skip the test while every flight stays in it (`substeps._in_rooms`):
+    every flight it lets through, the contact test, and the twin's all-pairs test, find free
+    of contacts; many are let through, and none where a disk leaves its room."""
+    shape, half, rim, table = WALLS[vessel]
+    walls = (shape, half[0], half[1], rim, table)
+    still = np.zeros((6, 2))
+    none = (rng.uniform(-1.0, 1.0, (6, 2)), np.full(6, -1.0))  # before any test, or no room
+    assert not substeps._in_rooms(none[0], still, 0.0, *none)
+    through = 0
+    for _ in range(40):
+        position, _, _, _, _, _, _ = scene(rng, 6, spread=rng.uniform(1.0, 3.5))
+        radius = rng.uniform(0.0, 0.4, 6)
+        centres, rooms = np.empty((6, 2)), np.empty(6)
+        substeps._rooms(position, radius, walls, centres, rooms)
+        for _ in range(50):
+            moved = position + rng.normal(0.0, 0.3, (6, 1)) * rng.normal(0.0, 0.3, (6, 2))
+            velocity = rng.normal(0.0, 1.0, (6, 2))
+            lag = rng.uniform(0.0, 0.3)
+            if not substeps._in_rooms(moved, velocity, lag, centres, rooms):
+                continue
+            through += 1
+            ends = moved + velocity * lag * (1.0 + CONTACT_MARGIN)
+            assert np.all(np.hypot(*(moved - centres).T) < rooms)
+            assert np.all(np.hypot(*(ends - centres).T) < rooms)
+            order, low, high, near = np.arange(6), np.empty(6), np.empty(6), np.empty(6, bool)
+            assert not substeps._contacts_ahead(moved, velocity, radius, lag, walls, order, low,
+                                                high, near)  # fmt: skip
+            if shape == BOX:
+                wall = reference._next_wall(moved, velocity, radius, half)[0]
+            else:
+                wall = reference._next_rim(moved, velocity, radius, rim, np.zeros(2))[0]
+            assert wall > lag
+            assert not near_disks(moved, velocity, radius, np.array([np.inf, np.inf]), lag).any()
+    assert through > 200

@@ -55,6 +55,12 @@ RECORD = ("kinetic", "potential", "virial", "px", "py", "total_speed")
 #: cell crossing), so round-off could otherwise part the two on a grazing contact.
 CONTACT_MARGIN = 1e-6
 
+#: Particles up to which the substeps keep each disk's room (`_rooms`): the disks' distances to
+#: the walls and to each other, all pairs, from the last contact test that found none, so that
+#: the substeps after it need no test while every disk stays in its room (`_in_rooms`). A gas
+#: of more meets contacts in most substeps, where the rooms would be small and their pairs many.
+ROOMS_UP_TO = 16
+
 #: The substeps read their rate every `rate_stride` substeps and at each interval's end, a
 #: stride being at most this fraction of the fastest time scale (``tolerance`` of it a
 #: substep): the rate changes by a few percent over it, while each read is a sum over the
@@ -378,7 +384,8 @@ def _work(mass, source, coupling, softening2, tally):
     softening (1,)); a copy of the ``tally``'s counts, impulses and heat, to put back; the
     order and rows of `collidium.kernels.pairwise.pruned_stiffness` (m,) and (6, m); the rows
     of `collidium.kernels.modified_energy.keep_across_step` (4, N); the disks that may meet a
-    contact in a substep (N,) (`_contacts_ahead`)."""
+    contact in a substep (N,) (`_contacts_ahead`); the disks' rooms' centres (N, 2) and radii
+    (N,), up to `ROOMS_UP_TO` disks (`_rooms`)."""
     n = mass.shape[0]
     m = 0
     for i in range(n):
@@ -400,9 +407,11 @@ def _work(mass, source, coupling, softening2, tally):
     pruning = (np.arange(m), np.empty((6, m)))
     gathered = (np.empty((4, n)),)
     near = (np.zeros(n, dtype=np.bool_),)
+    roomy = n if n <= ROOMS_UP_TO else 0
+    rooms = (np.empty((roomy, 2)), np.full(roomy, -1.0))  # none yet
     # Concatenated: numba builds an unpacked (*a, *b) through a list, which holds one type.
     return (motion + (index, charged, inverse_mass) + rows + sums + sweep + law  # noqa: RUF005
-            + kept + pruning + gathered + near)  # fmt: skip
+            + kept + pruning + gathered + near + rooms)  # fmt: skip
 
 
 @uncounted(error_model="numpy")
@@ -427,6 +436,7 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     kept = work[18:21]
     order_x, rows_x = work[21:23]
     near = work[24]
+    centres, rooms = work[25:27]
     engine = contacts[2] > 0  # events between re-sorts: 0 for no engine
     tolerance, most, energy_floor = accuracy
     stride = rate_stride(tolerance)
@@ -449,7 +459,12 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
             before += heat
         if not _finite(kicked):
             return s, t, fastest, given, processed, drifts, -1.0
-        meets = _contacts_ahead(position, kicked, radius, h, walls, order, low, high, near)
+        if _in_rooms(position, kicked, h, centres, rooms):  # no contact: the test would find none
+            meets = False
+        else:
+            meets = _contacts_ahead(position, kicked, radius, h, walls, order, low, high, near)
+            if not meets:
+                _rooms(position, radius, walls, centres, rooms)
         if meets:  # the exact engine takes the drift, if it may
             if not engine:
                 return s, t, fastest, given, processed, drifts, -1.0
@@ -748,8 +763,57 @@ def _contacts_ahead(position, velocity, radius, lag, walls, order, low, high, ne
     return meets
 
 
-#: The relative slack of `_clear_of_shape`, far above the round-off of its sums.
+#: The relative slack of `_clear_of_shape` and `_rooms`, far above the round-off of their sums.
 _SLACK = 1e-12
+
+
+@numba.njit(cache=True, inline="always")
+def _rooms(position, radius, walls, centres, rooms) -> None:
+    """Each disk's room: a circle about its position (``centres`` (N, 2), m) of a radius
+    (``rooms`` (N,), m) that keeps it clear of the walls and of every other disk's room by the
+    contact test's margin, so that while every disk stays in its room (`_in_rooms`), no straight
+    flight meets a contact, nor within `CONTACT_MARGIN` of one: at most the distance to the
+    box's sides or the circle's rim less the widened radius, and half a pair's gap less the
+    widened contact distance. Other shapes get no room (-1); nor does anything when the disks
+    are more than `ROOMS_UP_TO` (``rooms`` empty)."""
+    n = rooms.shape[0]
+    shape, half_width, half_height, rim = walls[0], walls[1], walls[2], walls[3]
+    for i in range(n):
+        x, y = position[i, 0], position[i, 1]
+        wide = radius[i] * (1.0 + CONTACT_MARGIN)
+        if walls[4].shape[0] > 0:  # segments: no room
+            room = -1.0
+        elif shape == BOX:
+            room = min(half_width - abs(x), half_height - abs(y)) - wide
+        elif shape == CIRCLE:
+            room = rim - math.hypot(x, y) - wide
+        else:
+            room = -1.0
+        for j in range(n):
+            sigma = (radius[i] + radius[j]) * (1.0 + CONTACT_MARGIN)
+            if j != i and sigma > 0.0:
+                gap = math.hypot(position[j, 0] - x, position[j, 1] - y) - sigma
+                room = min(room, 0.5 * gap)
+        centres[i, 0], centres[i, 1] = x, y
+        rooms[i] = room * (1.0 - _SLACK) if room > 0.0 else -1.0
+
+
+@numba.njit(cache=True, inline="always")
+def _in_rooms(position, velocity, lag, centres, rooms) -> bool:
+    """Whether every disk's straight flight over ``lag`` seconds (within `CONTACT_MARGIN` past
+    it, as the contact test takes it) stays in its room (`_rooms`): start and end inside a
+    circle, and the path with them. False where there are no rooms."""
+    if rooms.shape[0] == 0:
+        return False
+    horizon = lag * (1.0 + CONTACT_MARGIN)
+    for i in range(rooms.shape[0]):
+        room = rooms[i]
+        dx, dy = position[i, 0] - centres[i, 0], position[i, 1] - centres[i, 1]
+        ex, ey = dx + velocity[i, 0] * horizon, dy + velocity[i, 1] * horizon
+        reach = room * room
+        if not (room > 0.0 and dx * dx + dy * dy < reach and ex * ex + ey * ey < reach):
+            return False  # also NaN
+    return True
 
 
 @numba.njit(cache=True, inline="always")
