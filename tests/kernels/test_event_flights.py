@@ -28,10 +28,11 @@ def _gas(
     return Simulation(vessel, particles, forces=forces, dt=0.1).run(steps=1)
 
 
-def _fly(sim: Simulation, steps: int = STEPS) -> tuple[int, FlightRecord]:
+def _fly(sim: Simulation, steps: int = STEPS, read: bool = True) -> tuple[int, FlightRecord]:
+    """Steps flown in one call, each ``read`` by an observer or none."""
     drift = sim._drift
     assert isinstance(drift, ExactCollisions)
-    record = FlightRecord.empty(sim.tally, np.ones(steps, dtype=bool))
+    record = FlightRecord.empty(sim.tally, np.full(steps, read))
     origin, start = sim._time_origin
     flown = drift.fly(sim.particles, sim.container, origin, sim.steps - start, sim.dt, sim.tally,
                       record, sim._field.fall)  # fmt: skip
@@ -109,3 +110,43 @@ def test_a_failed_audit_ends_the_flight_after_its_step(rng, monkeypatch):
     flown, _ = _fly(sim)
     assert 1 <= flown < STEPS
     assert np.max(np.abs(sim.particles.position) + sim.particles.radius[:, None]) > now
+
+
+def _outcome(sim: Simulation, flown: int, record: FlightRecord) -> tuple[np.ndarray, ...]:
+    """The particles, the tallies and the counts recorded at the steps flown."""
+    p = sim.particles
+    return p.position, p.velocity, sim.tally.counts, sim.tally.impulse, record.counts[:flown]
+
+
+def test_steps_no_observer_reads_give_the_bits_of_steps_read(rng):
+    """Steps that no observer reads are audited from the engine's slots, the particles written
+    at the last (`events.audit_in_box`): the same particles, tallies and counts, bit for bit, as
+    steps that write them at each end."""
+    runs = []
+    for read in (True, False):
+        sim = _gas(np.random.default_rng(8), Box(20.0, 20.0), 20.0)
+        flown, record = _fly(sim, read=read)
+        assert flown == STEPS
+        runs.append(_outcome(sim, flown, record))
+    assert runs[0][4][-1, 0] > 5
+    for a, b in zip(*runs, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_an_unread_step_that_fails_the_audit_ends_the_flight_after_it(monkeypatch):
+    """The audit from the slots fails at the step the particles' audit fails at: the flight
+    ends after it, the particles written there, as when every step is read."""
+    code, _, _, slack, periodic = Box(20.0, 20.0).audit_arguments()
+    runs = []
+    for read in (True, False):
+        sim = _gas(np.random.default_rng(9), Box(20.0, 20.0), 20.0)
+        now = float(np.max(np.abs(sim.particles.position) + sim.particles.radius[:, None]))
+        with monkeypatch.context() as patch:
+            patch.setattr(Box, "audit_arguments", lambda self, now=now: (code, now, now, slack,
+                                                                         periodic))  # fmt: skip
+            flown, record = _fly(sim, read=read)
+        assert 1 <= flown < STEPS - 1
+        runs.append((flown, *_outcome(sim, flown, record)))
+    assert runs[0][0] == runs[1][0]
+    for a, b in zip(runs[0][1:], runs[1][1:], strict=True):
+        np.testing.assert_array_equal(a, b)

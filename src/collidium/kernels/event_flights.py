@@ -21,6 +21,7 @@ from collidium.kernels.audit import all_valid, first_past_face
 from collidium.kernels.compilation import uncounted
 from collidium.kernels.floats import largest_magnitude
 from collidium.kernels.sums import kinetic_energy, momentum, total_speed
+from collidium.kernels.vessels import BOX
 from collidium.kernels.vessels import piston as piston_kernels
 
 #: How `event_intervals` ended: every interval taken; at an interval that the drift must take
@@ -85,15 +86,26 @@ def event_intervals(
     -------
     tuple of int
         ``(steps taken, events processed, how it ended)``: `ALL`, `STOPPED`, `OUT_OF_WINDOW`,
-        or ``-1 - i`` if time stopped advancing at particle i in the step after those taken
-        (`events.run_events`; the tallies then hold part of that step).
+        or ``-1 - i`` if time stopped advancing at particle i in a later step (`events.run_events`;
+        the steps taken are then those whose end the particles hold, and the tallies hold part
+        of the steps after them).
+
+    In a box without segments or a piston the particles are written only at the steps an
+    observer reads, at the last and where a step stops the flight: the others are audited from
+    the slots (`events.audit_in_box`, the same verdicts), which spares the scattered writes
+    (0.8 of the 1.4 us a step of a 200-disk gas spent outside its events).
     """
     processed = 0
     falls = fall_x != 0.0 or fall_y != 0.0
+    in_box = audit_shape == BOX and segments.shape[0] == 0 and piston.shape[0] == 0
+    largest = largest_magnitude(velocity)
+    written, written_events, last = 0, 0, origin  # the steps whose end the particles hold
     for k in range(count):
         now = origin + (elapsed + k) * dt
-        speed = largest_magnitude(velocity) + max(abs(fall_x), abs(fall_y)) * dt
+        speed = largest + max(abs(fall_x), abs(fall_y)) * dt
         if not speed * dt <= reach:  # also NaN
+            if written < k:
+                events.synchronise(last, body, event, geometry, grid, position, velocity)
             return k, processed, STOPPED
         until = now + dt
         done = events.run_events(until, body, image, geometry, grid, head, next_, event, keys,
@@ -101,10 +113,18 @@ def event_intervals(
                                  sort_every, log, logged, walls, heat, segments,
                                  piston)  # fmt: skip
         if done < 0:
-            return k, processed, done
+            return written, written_events, done
         processed += done
-        strays = events.synchronise(until, body, event, geometry, grid, position, velocity)
         _tallies(k, tally, impulse, heat, counts, impulses, heats)
+        last = until
+        if in_box and not wanted[k] and k < count - 1:
+            valid, strays, largest = events.audit_in_box(until, body, geometry, grid, limit_x,
+                                                         limit_y, periodic)  # fmt: skip
+            if valid and (strays == 0 or window_is_vessel):
+                continue
+        strays = events.synchronise(until, body, event, geometry, grid, position, velocity)
+        written, written_events = k + 1, processed
+        largest = largest_magnitude(velocity)
         if wanted[k]:
             _record(k, mass, velocity, record)
             if falls:

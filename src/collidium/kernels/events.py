@@ -54,7 +54,7 @@ from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import bounce_factor, energy_change, pair_response
 from collidium.kernels.compilation import inlined, uncounted
 from collidium.kernels.stepper import chunk_count
-from collidium.kernels.vessels import BOX, contacts
+from collidium.kernels.vessels import BOX, box, contacts
 from collidium.kernels.vessels import piston as pistons
 
 #: Columns of the ``body`` rows. RADIUS and MASS exist only in rows of `BODY_COLUMNS`; rows of
@@ -1110,6 +1110,32 @@ def synchronise(now, body, event, geometry, grid, position, velocity) -> int:
     right, but slow when they are many)."""
     return _synchronise_between(0, body.shape[0], now, body, event, geometry, grid, position,
                                 velocity)  # fmt: skip
+
+
+@uncounted(nogil=True)
+def audit_in_box(now, body, geometry, grid, limit_x, limit_y, periodic) -> tuple[bool, int, float]:
+    """What `synchronise` and then the audit in a box without segments
+    (`collidium.kernels.audit.all_valid`) find at time ``now`` (s), read from the slots, the
+    particles not written: whether every particle is finite and inside the half sides
+    ``limit_x, limit_y`` (m; its centre alone if ``periodic``), how many are outside the cells'
+    window, and their largest velocity component (m/s; as
+    `collidium.kernels.floats.largest_magnitude` takes it from the velocities written). The
+    positions are `synchronise`'s, bit for bit: the verdicts are those of the particles that it
+    would write."""
+    x0, y0 = geometry[GRID_LEFT], geometry[GRID_BOTTOM]
+    x1 = x0 + grid[0] * geometry[CELL_WIDTH]
+    y1 = y0 + grid[1] * geometry[CELL_HEIGHT]
+    strays = 0
+    bad = False
+    largest = 0.0
+    for k in range(body.shape[0]):
+        x, y, vx, vy = _at(k, now, body, geometry)
+        finite = (x - x == 0.0) & (y - y == 0.0) & (vx - vx == 0.0) & (vy - vy == 0.0)  # NaN else
+        reach = 0.0 if periodic else _radius(k, body, geometry)
+        bad |= (not finite) | box.reaches_outside(x, y, reach, limit_x, limit_y)
+        strays += not (x0 <= x <= x1 and y0 <= y <= y1)
+        largest = max(largest, abs(vx), abs(vy))
+    return not bad, strays, largest
 
 
 @numba.njit(cache=True, parallel=True, nogil=True)
