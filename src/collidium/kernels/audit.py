@@ -7,7 +7,7 @@ import math
 import numba
 import numpy as np
 
-from collidium.kernels.compilation import uncounted
+from collidium.kernels.compilation import inlined, uncounted
 from collidium.kernels.stepper import chunk_count
 from collidium.kernels.vessels import BOX, box, contacts
 
@@ -88,11 +88,20 @@ def all_valid(position, velocity, radius, shape, limit_x, limit_y, slack, period
                         segments)[0] < 0  # fmt: skip
     bad = False
     for i in range(position.shape[0]):
-        x, y, vx, vy = position[i, 0], position[i, 1], velocity[i, 0], velocity[i, 1]
-        finite = (x - x == 0.0) & (y - y == 0.0) & (vx - vx == 0.0) & (vy - vy == 0.0)  # NaN else
         reach = 0.0 if periodic else radius[i]
-        bad |= (not finite) | box.reaches_outside(x, y, reach, limit_x, limit_y)
+        bad |= fails_in_box(position[i, 0], position[i, 1], velocity[i, 0], velocity[i, 1], reach,
+                            limit_x, limit_y)  # fmt: skip
     return not bad
+
+
+@inlined
+def fails_in_box(x, y, vx, vy, reach, limit_x, limit_y) -> bool:
+    """Whether a disk at (x, y) moving at (vx, vy) fails the audit of a box without segments:
+    a value not finite, or reaching ``reach`` m (its radius; 0 in a periodic box) past the half
+    sides ``limit_x, limit_y`` (m). Without branches, so that a pass over the disks
+    vectorises (`all_valid`, `collidium.kernels.events.audit_in_box`)."""
+    finite = (x - x == 0.0) & (y - y == 0.0) & (vx - vx == 0.0) & (vy - vy == 0.0)  # NaN else
+    return (not finite) | box.reaches_outside(x, y, reach, limit_x, limit_y)
 
 
 @numba.njit(cache=True, parallel=True, nogil=True)

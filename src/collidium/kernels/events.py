@@ -50,11 +50,12 @@ import numba
 import numpy as np
 
 from collidium.kernels import parabolas, wall_responses
+from collidium.kernels.audit import fails_in_box
 from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import bounce_factor, energy_change, pair_response
 from collidium.kernels.compilation import inlined, uncounted
 from collidium.kernels.stepper import chunk_count
-from collidium.kernels.vessels import BOX, box, contacts
+from collidium.kernels.vessels import BOX, contacts
 from collidium.kernels.vessels import piston as pistons
 
 #: Columns of the ``body`` rows. RADIUS and MASS exist only in rows of `BODY_COLUMNS`; rows of
@@ -1122,20 +1123,24 @@ def audit_in_box(now, body, geometry, grid, limit_x, limit_y, periodic) -> tuple
     `collidium.kernels.floats.largest_magnitude` takes it from the velocities written). The
     positions are `synchronise`'s, bit for bit: the verdicts are those of the particles that it
     would write."""
-    x0, y0 = geometry[GRID_LEFT], geometry[GRID_BOTTOM]
-    x1 = x0 + grid[0] * geometry[CELL_WIDTH]
-    y1 = y0 + grid[1] * geometry[CELL_HEIGHT]
+    x0, y0, x1, y1 = _window(geometry, grid)
     strays = 0
     bad = False
     largest = 0.0
     for k in range(body.shape[0]):
         x, y, vx, vy = _at(k, now, body, geometry)
-        finite = (x - x == 0.0) & (y - y == 0.0) & (vx - vx == 0.0) & (vy - vy == 0.0)  # NaN else
         reach = 0.0 if periodic else _radius(k, body, geometry)
-        bad |= (not finite) | box.reaches_outside(x, y, reach, limit_x, limit_y)
+        bad |= fails_in_box(x, y, vx, vy, reach, limit_x, limit_y)
         strays += not (x0 <= x <= x1 and y0 <= y <= y1)
         largest = max(largest, abs(vx), abs(vy))
     return not bad, strays, largest
+
+
+@inlined
+def _window(geometry, grid) -> tuple[float, float, float, float]:
+    """The cells' window: its left, bottom, right and top (m)."""
+    x0, y0 = geometry[GRID_LEFT], geometry[GRID_BOTTOM]
+    return x0, y0, x0 + grid[0] * geometry[CELL_WIDTH], y0 + grid[1] * geometry[CELL_HEIGHT]
 
 
 @numba.njit(cache=True, parallel=True, nogil=True)
@@ -1154,9 +1159,7 @@ def synchronise_in_chunks(now, body, event, geometry, grid, position, velocity) 
 @inlined
 def _synchronise_between(start, stop, now, body, event, geometry, grid, position, velocity):
     """`synchronise` for the slots ``start`` to ``stop - 1``: their strays."""
-    x0, y0 = geometry[GRID_LEFT], geometry[GRID_BOTTOM]
-    x1 = x0 + grid[0] * geometry[CELL_WIDTH]
-    y1 = y0 + grid[1] * geometry[CELL_HEIGHT]
+    x0, y0, x1, y1 = _window(geometry, grid)
     strays = 0
     for k in range(start, stop):
         i = event[k, IDENT]
