@@ -170,6 +170,18 @@ def test_forces_too_strong_for_dt_stop_the_run_at_once():
     assert sim.steps == 0
 
 
+def test_a_dt_whose_substep_squared_overflows_stops_the_run_in_one_line():
+    """dt = 1e300 (the fuzz test found it): the processing's shift, of the substep squared, is
+    infinite, not an overflow raised from Python; the run stops with a simulation error and the
+    particles as they were shown."""
+    sim = cd.load("orbit", dt=1e300)
+    before = sim.particles.position.copy(), sim.particles.velocity.copy()
+    with pytest.raises(SimulationError):
+        sim.run(steps=1)
+    np.testing.assert_array_equal(sim.particles.position, before[0])
+    np.testing.assert_array_equal(sim.particles.velocity, before[1])
+
+
 def test_a_disk_hitting_its_walls_thousands_of_times_in_a_substep_is_taken_whole():
     """A charged disk at 1e8 m/s (a third of light's speed) across a 20 m box under a weak
     electric field hits its side walls about 51000 times in one dt: the drift takes them all,

@@ -889,7 +889,7 @@ class _Shown:
         particles of the step before (`matches` checked them)."""
         own = cls(particles.position.copy(), particles.velocity.copy(), np.empty(0), np.empty(0),
                   field.saved(), made_with)  # fmt: skip
-        _process(particles, vessel, field, field.acceleration, processing.SHARE * substep**2)
+        _process(particles, vessel, field, field.acceleration, processing.SHARE * substep * substep)
         own.shown_position = particles.position.copy()
         own.shown_velocity = particles.velocity.copy()
         return own
@@ -902,7 +902,7 @@ class _Shown:
         processing (the flow back), the particles left as they are."""
         shown_position, shown_velocity = particles.position.copy(), particles.velocity.copy()
         acceleration = field.refresh(particles, vessel)
-        _process(particles, vessel, field, acceleration, -processing.SHARE * substep**2)
+        _process(particles, vessel, field, acceleration, -processing.SHARE * substep * substep)
         own = cls(particles.position.copy(), particles.velocity.copy(), shown_position,
                   shown_velocity, None, _made_with(particles, vessel, field))  # fmt: skip
         particles.position[...], particles.velocity[...] = shown_position, shown_velocity
