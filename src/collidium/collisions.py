@@ -151,6 +151,15 @@ class ContactLog:
     def __init__(self, capacity: int = 64) -> None:
         self.rows = np.empty((capacity, events.LOG_COLUMNS))
         self.count = np.zeros(1, dtype=np.int64)
+        self._latest = np.empty(0, dtype=np.int64)
+
+    def latest(self, n: int) -> IntArray:
+        """The correction's work array for n particles, -1 everywhere
+        (`collidium.kernels.kick_timing.correct`, which leaves it so): kept, not made anew for
+        each substep."""
+        if self._latest.shape[0] != n:
+            self._latest = np.full(n, -1, dtype=np.int64)
+        return self._latest
 
     def clear(self) -> None:
         """Forget the contacts logged."""

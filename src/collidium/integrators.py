@@ -580,7 +580,7 @@ def _corrected(
     kick_timing.correct(
         log.rows, int(log.count[0]), t, h, start, particles.position, before, after,
         particles.velocity, writable(particles.mass), *field.pair_laws(particles), width, height,
-        vessel.periodic, field.follows_laws(particles, vessel),
+        vessel.periodic, field.follows_laws(particles, vessel), log.latest(particles.n),
     )  # fmt: skip
 
 

@@ -26,8 +26,10 @@ def logged(rows):
 def corrected(contacts, t0, h, start, position, before, after, velocity, mass, laws, size=None,
               shadow=False):  # fmt: skip
     """`kick_timing.correct` on a copy of ``velocity``, the laws stacked as the kernel takes
-    them; the modified energy's term left out unless ``shadow``."""
+    them; the modified energy's term left out unless ``shadow``. Its work array of the
+    particles' latest contacts is -1 again on return."""
     out = velocity.copy()
+    latest = np.full(mass.size, -1, dtype=np.int64)
     contacts = contacts.copy()
     sources = np.array([law[0] for law in laws]).reshape(len(laws), mass.size)
     couplings = np.array([law[1] for law in laws], dtype=float)
@@ -35,7 +37,8 @@ def corrected(contacts, t0, h, start, position, before, after, velocity, mass, l
     width, height = (10.0, 10.0) if size is None else size
     kick_timing.correct(contacts, contacts.shape[0], t0, h, start, position, before, after, out,
                         mass, sources, couplings, softenings2, width, height,
-                        size is not None, shadow)  # fmt: skip
+                        size is not None, shadow, latest)  # fmt: skip
+    assert (latest == -1).all()
     return out
 
 

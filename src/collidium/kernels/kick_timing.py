@@ -91,6 +91,7 @@ def correct(
     height: float,
     periodic: bool,
     shadow: bool,
+    latest: np.ndarray,
 ) -> None:
     """Add the second-order kick-timing correction of a substep's contacts to the velocities of
     their particles, in place, and with ``shadow`` take each contact's jump of the modified
@@ -122,11 +123,15 @@ def correct(
     shadow : bool
         Whether the pair forces are their laws' gradients, summed directly (the modified
         energy's term needs it).
+    latest : ndarray of int64, shape (N,)
+        Work array, -1 everywhere on entry and again on return: each particle's latest contact
+        row so far, so that the correction takes time linear in the contacts.
     """
     shadow = shadow and couplings.shape[0] > 0
     for c in range(count):
         _carry(c, contacts, start_time, h, start, position, before, after, mass, sources,
-               couplings, softenings2, width, height, periodic)  # fmt: skip
+               couplings, softenings2, width, height, periodic, latest)  # fmt: skip
+        _set_latest(c, c, contacts, latest)
         contacts[c, LOG_DROP] = 0.0
         if shadow and contacts[c, LOG_BOUNCE] != 0.0:
             contacts[c, LOG_DROP] = _shadow_jump(
@@ -140,7 +145,7 @@ def correct(
         rest = h - (contacts[c, LOG_TIME] - start_time)
         for member in range(2 if partner >= 0 else 1):
             k = int(contacts[c, LOG_PARTICLE]) if member == 0 else partner
-            if _in_rows(k, c + 1, count, contacts):
+            if latest[k] != c:  # a later contact of k carries its error on
                 continue
             for d in range(2):
                 error = contacts[c, LOG_ERROR + 2 * member + d]
@@ -153,11 +158,22 @@ def correct(
             _take_along_normal(int(contacts[c, LOG_PARTICLE]), int(contacts[c, LOG_PARTNER]),
                                drop, contacts[c, LOG_NX], contacts[c, LOG_NY], velocity,
                                mass)  # fmt: skip
+    for c in range(count):
+        _set_latest(c, -1, contacts, latest)
+
+
+@inlined
+def _set_latest(c, value, contacts, latest) -> None:
+    """Set the ``latest`` entry of contact ``c``'s particle and partner (not a wall's)."""
+    latest[int(contacts[c, LOG_PARTICLE])] = value
+    partner = int(contacts[c, LOG_PARTNER])
+    if partner >= 0:
+        latest[partner] = value
 
 
 @inlined
 def _carry(c, contacts, start_time, h, start, position, before, after, mass, sources, couplings,
-           softenings2, width, height, periodic) -> None:  # fmt: skip
+           softenings2, width, height, periodic, latest) -> None:  # fmt: skip
     """Carry the velocity errors of contact ``c``'s particles from their previous contacts (or
     the substep's start) to it and through its map C, and log them with their accelerations
     at the contact (``LOG_ERROR``, ``LOG_PULL``). An uncorrected contact (bounce factor 0)
@@ -181,10 +197,10 @@ def _carry(c, contacts, start_time, h, start, position, before, after, mass, sou
                              mass, nx, ny)  # fmt: skip
         jx, jy = _at_contact(j, -f0 * s0x, -f0 * s0y, -fh * shx, -fh * shy, -fc, share, before,
                              after, mass, nx, ny)  # fmt: skip
-    eix, eiy = _error_at(i, c, tau, ix, iy, contacts, start_time, before)
+    eix, eiy = _error_at(i, latest[i], tau, ix, iy, contacts, start_time, before)
     ejx, ejy = 0.0, 0.0
     if partner >= 0:
-        ejx, ejy = _error_at(partner, c, tau, jx, jy, contacts, start_time, before)
+        ejx, ejy = _error_at(partner, latest[partner], tau, jx, jy, contacts, start_time, before)
     bounce = contacts[c, LOG_BOUNCE]
     n2 = nx * nx + ny * ny
     if bounce == 0.0:
@@ -203,21 +219,18 @@ def _carry(c, contacts, start_time, h, start, position, before, after, mass, sou
 
 
 @inlined
-def _error_at(k, c, tau, ax, ay, contacts, start_time, before) -> tuple[float, float]:
-    """Particle k's velocity error (m/s) just before contact ``c`` at ``tau`` s, where its
-    acceleration is (ax, ay): the error after its previous contact (none at the substep's
-    start), plus the impulse its acceleration, linear in between, gave beyond the kick's
-    constant ``a0``."""
+def _error_at(k, previous, tau, ax, ay, contacts, start_time, before) -> tuple[float, float]:
+    """Particle k's velocity error (m/s) just before a contact at ``tau`` s, where its
+    acceleration is (ax, ay): the error after its ``previous`` contact (a row, or -1 for none:
+    the substep's start), plus the impulse its acceleration, linear in between, gave beyond the
+    kick's constant ``a0``."""
     ex, ey, t, px, py = 0.0, 0.0, 0.0, before[k, 0], before[k, 1]
-    for previous in range(c - 1, -1, -1):
-        p, q = int(contacts[previous, LOG_PARTICLE]), int(contacts[previous, LOG_PARTNER])
-        if k in (p, q):
-            row = contacts[previous]
-            slot = 0 if k == p else 2
-            ex, ey = row[LOG_ERROR + slot], row[LOG_ERROR + slot + 1]
-            px, py = row[LOG_PULL + slot], row[LOG_PULL + slot + 1]
-            t = row[LOG_TIME] - start_time
-            break
+    if previous >= 0:
+        row = contacts[previous]
+        slot = 0 if k == int(row[LOG_PARTICLE]) else 2
+        ex, ey = row[LOG_ERROR + slot], row[LOG_ERROR + slot + 1]
+        px, py = row[LOG_PULL + slot], row[LOG_PULL + slot + 1]
+        t = row[LOG_TIME] - start_time
     span = tau - t
     return (ex + (0.5 * (px + ax) - before[k, 0]) * span,
             ey + (0.5 * (py + ay) - before[k, 1]) * span)  # fmt: skip

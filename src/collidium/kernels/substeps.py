@@ -385,7 +385,8 @@ def _work(mass, source, coupling, softening2, tally):
     order and rows of `collidium.kernels.pairwise.pruned_stiffness` (m,) and (6, m); the rows
     of `collidium.kernels.modified_energy.keep_across_step` (4, N); the disks that may meet a
     contact in a substep (N,) (`_contacts_ahead`); the disks' rooms' centres (N, 2) and radii
-    (N,), up to `ROOMS_UP_TO` disks (`_rooms`)."""
+    (N,), up to `ROOMS_UP_TO` disks (`_rooms`); each particle's latest contact in a substep
+    (N,), -1 between substeps (`collidium.kernels.kick_timing.correct`)."""
     n = mass.shape[0]
     m = 0
     for i in range(n):
@@ -409,9 +410,10 @@ def _work(mass, source, coupling, softening2, tally):
     near = (np.zeros(n, dtype=np.bool_),)
     roomy = n if n <= ROOMS_UP_TO else 0
     rooms = (np.empty((roomy, 2)), np.full(roomy, -1.0))  # none yet
+    latest = (np.full(n, -1, dtype=np.int64),)
     # Concatenated: numba builds an unpacked (*a, *b) through a list, which holds one type.
     return (motion + (index, charged, inverse_mass) + rows + sums + sweep + law  # noqa: RUF005
-            + kept + pruning + gathered + near + rooms)  # fmt: skip
+            + kept + pruning + gathered + near + rooms + latest)  # fmt: skip
 
 
 @uncounted(error_model="numpy")
@@ -437,6 +439,7 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
     order_x, rows_x = work[21:23]
     near = work[24]
     centres, rooms = work[25:27]
+    latest = work[27]
     engine = contacts[2] > 0  # events between re-sorts: 0 for no engine
     tolerance, most, energy_floor = accuracy
     stride = rate_stride(tolerance)
@@ -489,8 +492,8 @@ def _substeps(position, velocity, acceleration, mass, radius, coupling, softenin
             return s, t, fastest, given, processed, drifts, -1.0
         if meets:
             kick_timing.correct(log, logged[0], t, h, position, flown, acceleration, pull,
-                                kicked, mass, law[0], law[1], law[2], 0.0, 0.0, False,
-                                True)  # fmt: skip
+                                kicked, mass, law[0], law[1], law[2], 0.0, 0.0, False, True,
+                                latest)  # fmt: skip
             processed += done
             drifts += 1
         after = 0.0
