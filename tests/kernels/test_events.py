@@ -8,6 +8,7 @@ import pytest
 from collidium import Box, Circle, Gravity, Particles, Simulation, collisions
 from collidium.kernels import audit, cells, events, reference
 from collidium.kernels.events import contact_delay
+from collidium.kernels.vessels import BOX, CIRCLE, box
 from lattices import jittered_lattice
 
 
@@ -394,3 +395,39 @@ def test_a_queue_built_again_from_the_slots_before_runs_as_a_fresh_one(rng):
     assert kept.counters.pair_collisions > 3000
     for a, b in zip(_outcome(kept), _outcome(fresh_run), strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+def test_a_disk_off_the_grids_edge_leaves_its_cell_before_it_can_touch_a_wall(rng):
+    """The prediction looks for wall contacts only from the cells at the grid's edge
+    (`events._walls_in_reach`): in a box without segments, from any other cell, with the cells
+    as narrow as the grid allows (one largest diameter), the crossing out of the cell comes
+    strictly first, from every place in the cell (its edges too) and in every direction."""
+    radius, ncx, ncy = 0.5, 7, 5
+    size = 2.0 * radius  # the narrowest cells `cells.event_grid_shape` gives
+    half_width, half_height = ncx * size / 2, ncy * size / 2
+    geometry = np.zeros(events.GEOMETRY_SIZE)
+    geometry[[events.CELL_WIDTH, events.CELL_HEIGHT]] = size
+    geometry[[events.GRID_LEFT, events.GRID_BOTTOM]] = -half_width, -half_height
+    grid = np.array([ncx, ncy, 0])
+    geometry[events.SHAPE] = BOX
+    no_segments = np.empty((0, 9))
+    tested = 0
+    for _ in range(4000):
+        cx, cy = rng.integers(0, ncx), rng.integers(0, ncy)
+        c = cx + ncx * cy
+        # Anywhere in the cell, edges included, and every direction.
+        u, v = rng.choice([0.0, 1.0, rng.uniform()], 2)
+        x, y = -half_width + (cx + u) * size, -half_height + (cy + v) * size
+        vx, vy = rng.normal(size=2) * rng.choice([1e-3, 1.0, 1e3])
+        crossing, _ = events._cell_crossing(x, y, vx, vy, c, geometry, grid)
+        wall, _ = box.wall_delay(x, y, vx, vy, radius, half_width, half_height)
+        if events._walls_in_reach(c, geometry, grid, no_segments):
+            continue
+        tested += 1
+        assert crossing < wall
+    assert tested > 1000
+    # An edge cell, a box with segments and a circle keep their walls.
+    assert events._walls_in_reach(0, geometry, grid, no_segments)
+    assert events._walls_in_reach(ncx + 1, geometry, grid, np.zeros((1, 9)))
+    geometry[events.SHAPE] = CIRCLE
+    assert events._walls_in_reach(ncx + 1, geometry, grid, no_segments)

@@ -331,12 +331,26 @@ def _walls_and_cells(x, y, vx, vy, r, c, geometry, grid, segments, piston, now):
         wall, contact = pistons.earliest(x, y, vx, vy, r, hw, hh, piston, now, gx, gy)
         if wall <= best:
             best, code = wall, FIRST_WALL_CODE - contact
-    elif not periodic:
+    elif not periodic and _walls_in_reach(c, geometry, grid, segments):
         wall, contact = contacts.earliest(x, y, vx, vy, r, geometry[SHAPE], hw, hh, geometry[RIM],
                                           segments, gx, gy, best)  # fmt: skip
         if contact >= 0 and wall <= best:
             best, code = wall, FIRST_WALL_CODE - contact
     return best, code
+
+
+@inlined
+def _walls_in_reach(c, geometry, grid, segments) -> bool:
+    """Whether a disk in cell c may touch a wall before it leaves the cell: in a box without
+    segments only from a cell at the grid's edge, as the cells are at least one diameter wide
+    and the grid lies inside the box (`collidium.kernels.cells.event_grid_shape`,
+    `grid_window`); a wall is at least a diameter away from any other, and the disk crosses
+    into the next cell first."""
+    if geometry[SHAPE] != BOX or segments.shape[0] > 0:
+        return True
+    ncx = grid[0]
+    cx, cy = c % ncx, c // ncx
+    return cx == 0 or cy == 0 or cx == ncx - 1 or cy == grid[1] - 1
 
 
 @inlined
