@@ -98,10 +98,12 @@ def all_valid(position, velocity, radius, shape, limit_x, limit_y, slack, period
 def fails_in_box(x, y, vx, vy, reach, limit_x, limit_y) -> bool:
     """Whether a disk at (x, y) moving at (vx, vy) fails the audit of a box without segments:
     a value not finite, or reaching ``reach`` m (its radius; 0 in a periodic box) past the half
-    sides ``limit_x, limit_y`` (m). Without branches, so that a pass over the disks
-    vectorises (`all_valid`, `collidium.kernels.events.audit_in_box`)."""
-    finite = (x - x == 0.0) & (y - y == 0.0) & (vx - vx == 0.0) & (vy - vy == 0.0)  # NaN else
-    return (not finite) | box.reaches_outside(x, y, reach, limit_x, limit_y)
+    sides ``limit_x, limit_y`` (m). Without branches (`all_valid`,
+    `collidium.kernels.events.audit_in_box`). `collidium.kernels.vessels.box.reaches_outside`
+    finds the coordinates that are not finite too, which spares testing them apart (a tenth of
+    a microsecond a step of a 200-disk gas)."""
+    moving = (vx - vx == 0.0) & (vy - vy == 0.0)  # NaN else
+    return box.reaches_outside(x, y, reach, limit_x, limit_y) | (not moving)
 
 
 @numba.njit(cache=True, parallel=True, nogil=True)

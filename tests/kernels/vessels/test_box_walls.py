@@ -4,6 +4,7 @@ bounce-by-bounce, time to a wall equal to its twin and ending at the contact poi
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -78,3 +79,10 @@ def test_wall_delay_equals_its_twin_and_ends_at_the_contact_coordinate(x, y, vx,
 def test_a_disk_at_rest_meets_no_wall_and_one_past_a_wall_is_outside():
     assert wall_delay(0.0, 0.0, 0.0, 0.0, 0.5, 5.0, 3.0) == (np.inf, -1)
     assert reaches_outside(4.6, 0.0, 0.5, 5.0, 3.0) and not reaches_outside(4.5, 2.5, 0.5, 5.0, 3.0)
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_a_coordinate_that_is_not_finite_is_outside(bad):
+    """The audit of a box leaves the finiteness of the positions to this test
+    (`collidium.kernels.audit.fails_in_box`)."""
+    assert reaches_outside(bad, 0.0, 0.5, 5.0, 3.0) and reaches_outside(0.0, bad, 0.0, 5.0, 3.0)

@@ -89,8 +89,9 @@ def contact_coordinate(wall: int, r: float, half_width: float, half_height: floa
 @inlined
 def reaches_outside(x: float, y: float, reach: float, limit_x: float, limit_y: float) -> bool:
     """Whether a disk at (x, y) reaching ``reach`` m from its centre (its radius; 0 for the
-    centre alone) passes the half sides ``limit_x, limit_y`` (m, round-off allowance included)."""
-    return abs(x) + reach > limit_x or abs(y) + reach > limit_y
+    centre alone) passes the half sides ``limit_x, limit_y`` (m, round-off allowance included),
+    or has a coordinate that is not finite: a NaN is within no sides. Without branches."""
+    return not ((abs(x) + reach <= limit_x) & (abs(y) + reach <= limit_y))
 
 
 @inlined
