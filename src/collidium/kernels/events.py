@@ -103,7 +103,7 @@ LOG_COLUMNS = 17
 
 #: Children per node of the event queue's heap: 8 keys fill one 64-byte line, and the heap is a
 #: third as deep as a binary one.
-ARITY = 8
+ARITY = 8  # `_least_of_eight` takes the children of a node
 
 #: Event codes below 0: a crossing into the neighbouring cell in direction d (0 -x, 1 +x, 2 -y,
 #: 3 +y) is ``-1 - d``; contact c with the vessel (`collidium.kernels.vessels.contacts`: the
@@ -236,12 +236,15 @@ def _sift_down(slot, key, item, keys, items, where) -> None:
         first = ARITY * slot + 1
         if first >= n:
             break
-        child = first
-        least = keys[first]
-        for c in range(first + 1, min(first + ARITY, n)):
-            if keys[c] < least:
-                child = c
-                least = keys[c]
+        if first + ARITY <= n:
+            child, least = _least_of_eight(keys, first)
+        else:
+            child = first
+            least = keys[first]
+            for c in range(first + 1, n):
+                if keys[c] < least:
+                    child = c
+                    least = keys[c]
         if key <= least:
             break
         keys[slot] = least
@@ -252,6 +255,29 @@ def _sift_down(slot, key, item, keys, items, where) -> None:
     keys[slot] = key
     items[slot] = item
     where[item] = slot
+
+
+@inlined
+def _least(a, b, ia, ib):
+    """The lesser of keys a and b with its index (ia, ib); a on a tie. Selects, not branches."""
+    later = b < a
+    return (b if later else a), (ib if later else ia)
+
+
+@inlined
+def _least_of_eight(keys, first):
+    """``(index, key)`` of the least of ``keys[first:first + 8]``, the first on a tie: a
+    tournament of pairs, three compares deep rather than seven in a row, without branches (which
+    way the minimum goes is a coin toss, and a mispredicted branch costs more than the
+    compares)."""
+    v01, i01 = _least(keys[first], keys[first + 1], 0, 1)
+    v23, i23 = _least(keys[first + 2], keys[first + 3], 2, 3)
+    v45, i45 = _least(keys[first + 4], keys[first + 5], 4, 5)
+    v67, i67 = _least(keys[first + 6], keys[first + 7], 6, 7)
+    v03, i03 = _least(v01, v23, i01, i23)
+    v47, i47 = _least(v45, v67, i45, i67)
+    v, i = _least(v03, v47, i03, i47)
+    return first + i, v
 
 
 @inlined
