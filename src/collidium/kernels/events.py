@@ -317,11 +317,15 @@ def _earliest_tied(keys, items, ident) -> int:
 
 @inlined
 def earliest(keys, items, ident) -> int:
-    """The slot whose event comes first in the order (time, ident)."""
-    for c in range(1, min(ARITY + 1, keys.shape[0])):
-        if keys[c] == keys[0]:
-            return _earliest_tied(keys, items, ident)
-    return items[0]
+    """The slot whose event comes first in the order (time, ident): the root's, unless one of
+    its children ties with it (none is earlier), which their least tells without a branch each."""
+    if keys.shape[0] > ARITY:
+        tied = _least_of_eight(keys, 1)[1] == keys[0]
+    else:
+        tied = False
+        for c in range(1, keys.shape[0]):
+            tied |= keys[c] == keys[0]
+    return _earliest_tied(keys, items, ident) if tied else items[0]
 
 
 @uncounted()
