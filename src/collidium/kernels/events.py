@@ -103,7 +103,7 @@ LOG_COLUMNS = 17
 
 #: Children per node of the event queue's heap: 8 keys fill one 64-byte line, and the heap is a
 #: third as deep as a binary one.
-ARITY = 8  # `_least_of_eight` takes the children of a node
+ARITY = 8
 
 #: Event codes below 0: a crossing into the neighbouring cell in direction d (0 -x, 1 +x, 2 -y,
 #: 3 +y) is ``-1 - d``; contact c with the vessel (`collidium.kernels.vessels.contacts`: the
@@ -236,7 +236,7 @@ def _sift_down(slot, key, item, keys, items, where) -> None:
         first = ARITY * slot + 1
         if first >= n:
             break
-        if first + ARITY <= n:
+        if ARITY == 8 and first + ARITY <= n:  # a constant: the test is compiled away
             child, least = _least_of_eight(keys, first)
         else:
             child = first
@@ -319,7 +319,7 @@ def _earliest_tied(keys, items, ident) -> int:
 def earliest(keys, items, ident) -> int:
     """The slot whose event comes first in the order (time, ident): the root's, unless one of
     its children ties with it (none is earlier), which their least tells without a branch each."""
-    if keys.shape[0] > ARITY:
+    if ARITY == 8 and keys.shape[0] > ARITY:
         tied = _least_of_eight(keys, 1)[1] == keys[0]
     else:
         tied = False
