@@ -431,3 +431,37 @@ def test_a_disk_off_the_grids_edge_leaves_its_cell_before_it_can_touch_a_wall(rn
     assert events._walls_in_reach(ncx + 1, geometry, grid, np.zeros((1, 9)))
     geometry[events.SHAPE] = CIRCLE
     assert events._walls_in_reach(ncx + 1, geometry, grid, no_segments)
+
+
+@pytest.mark.parametrize("trouble", ["none", "outside", "nan", "inf"])
+def test_the_plain_box_audit_gives_the_verdicts_of_the_full_one(trouble):
+    """`events.audit_in_box` takes disks of one radius that no gravity pulls without the
+    gravity's terms and without counting strays (`_audit_plain`): whether the disks pass and
+    their largest velocity component are those of the full audit, from the same slots, whatever
+    is wrong with them."""
+    sim = cd_gas()
+    s = sim._drift._state
+    assert s["body"].shape[1] == events.SHARED_BODY_COLUMNS
+    body = s["body"].copy()
+    k = 17
+    if trouble == "outside":
+        body[k, events.X] = 0.5 * sim.container.size[0] + 0.1
+    elif trouble in ("nan", "inf"):
+        body[k, events.VY] = np.nan if trouble == "nan" else -np.inf
+    limit_x, limit_y = 0.5 * sim.container.size * (1 + 1e-12)
+    later = sim.time  # where the drift left the disks: every one inside
+    verdicts = [
+        events.audit_in_box(later, body, s["geometry"], s["grid"], limit_x, limit_y, False, plain)
+        for plain in (True, False)
+    ]
+    (valid, strays, largest), (valid_full, _, largest_full) = verdicts
+    assert strays == 0
+    assert valid == valid_full == (trouble == "none")
+    assert largest == largest_full or (np.isnan(largest) and np.isnan(largest_full))
+
+
+def cd_gas() -> Simulation:
+    """The gas preset a little way in (disks of one radius, a box that is its cells' window)."""
+    import collidium as cd
+
+    return cd.load("gas").run(steps=3)

@@ -119,7 +119,8 @@ def event_intervals(
         last = until
         if in_box and not wanted[k] and k < count - 1:
             valid, strays, largest = events.audit_in_box(until, body, geometry, grid, limit_x,
-                                                         limit_y, periodic)  # fmt: skip
+                                                         limit_y, periodic,
+                                                         window_is_vessel)  # fmt: skip
             if valid and (strays == 0 or window_is_vessel):
                 continue
         strays = events.synchronise(until, body, event, geometry, grid, position, velocity)

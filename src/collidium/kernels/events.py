@@ -1158,15 +1158,21 @@ def synchronise(now, body, event, geometry, grid, position, velocity) -> int:
 
 
 @uncounted(nogil=True)
-def audit_in_box(now, body, geometry, grid, limit_x, limit_y, periodic) -> tuple[bool, int, float]:
+def audit_in_box(now, body, geometry, grid, limit_x, limit_y, periodic,
+                 window_is_vessel) -> tuple[bool, int, float]:  # fmt: skip
     """What `synchronise` and then the audit in a box without segments
     (`collidium.kernels.audit.all_valid`) find at time ``now`` (s), read from the slots, the
     particles not written: whether every particle is finite and inside the half sides
     ``limit_x, limit_y`` (m; its centre alone if ``periodic``), how many are outside the cells'
-    window, and their largest velocity component (m/s; as
+    window (counted only where the window is not the vessel, ``window_is_vessel``: a disk inside
+    the vessel is inside it), and their largest velocity component (m/s; as
     `collidium.kernels.floats.largest_magnitude` takes it from the velocities written). The
-    positions are `synchronise`'s, bit for bit: the verdicts are those of the particles that it
-    would write."""
+    positions are `synchronise`'s, bit for bit, or for disks of one radius that no gravity
+    pulls (`_audit_plain`) but for the sign of a zero, which no verdict reads: the verdicts are
+    those of the particles that it would write."""
+    plain = geometry[FALL_X] == 0.0 and geometry[FALL_Y] == 0.0
+    if plain and window_is_vessel and not periodic and body.shape[1] == SHARED_BODY_COLUMNS:
+        return _audit_plain(now, body, geometry[SHARED_RADIUS], limit_x, limit_y)
     x0, y0, x1, y1 = _window(geometry, grid)
     strays = 0
     bad = False
@@ -1178,6 +1184,23 @@ def audit_in_box(now, body, geometry, grid, limit_x, limit_y, periodic) -> tuple
         strays += not (x0 <= x <= x1 and y0 <= y <= y1)
         largest = max(largest, abs(vx), abs(vy))
     return not bad, strays, largest
+
+
+@inlined
+def _audit_plain(now, body, radius, limit_x, limit_y) -> tuple[bool, int, float]:
+    """`audit_in_box` for disks of one ``radius`` (m) that no gravity pulls, in a walled box
+    that is the cells' window: each position from its row without the gravity's terms (zero:
+    the same position but for the sign of a zero), and no strays counted: what is left of a
+    200-disk gas's step outside its events went from 0.67-0.71 to 0.42-0.47 us."""
+    bad = False
+    largest = 0.0
+    for k in range(body.shape[0]):
+        lag = now - body[k, STAMP]
+        vx, vy = body[k, VX], body[k, VY]
+        x, y = body[k, X] + vx * lag, body[k, Y] + vy * lag
+        bad |= fails_in_box(x, y, vx, vy, radius, limit_x, limit_y)
+        largest = max(largest, abs(vx), abs(vy))
+    return not bad, 0, largest
 
 
 @inlined
