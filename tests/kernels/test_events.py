@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from collidium import Box, Circle, Gravity, Particles, Simulation, collisions
+from collidium import Box, Circle, Gravity, Particles, Simulation, collisions, load
 from collidium.kernels import audit, cells, events, reference
 from collidium.kernels.events import contact_delay
 from collidium.kernels.vessels import BOX, CIRCLE, box
@@ -434,12 +434,12 @@ def test_a_disk_off_the_grids_edge_leaves_its_cell_before_it_can_touch_a_wall(rn
 
 
 @pytest.mark.parametrize("trouble", ["none", "outside", "nan", "inf"])
-def test_the_plain_box_audit_gives_the_verdicts_of_the_full_one(trouble):
-    """`events.audit_in_box` takes disks of one radius that no gravity pulls without the
-    gravity's terms and without counting strays (`_audit_plain`): whether the disks pass and
-    their largest velocity component are those of the full audit, from the same slots, whatever
-    is wrong with them."""
-    sim = cd_gas()
+def test_the_audit_of_disks_of_one_radius_gives_the_verdicts_of_full_rows(trouble):
+    """`events.audit_in_box` reads a radius that the disks share once, and counts no strays
+    where the cells' window is the vessel: whether the disks pass and their largest velocity
+    component are those of the same slots in full rows (each its radius), strays counted,
+    whatever is wrong with them."""
+    sim = load("gas").run(steps=3)
     s = sim._drift._state
     assert s["body"].shape[1] == events.SHARED_BODY_COLUMNS
     body = s["body"].copy()
@@ -448,20 +448,15 @@ def test_the_plain_box_audit_gives_the_verdicts_of_the_full_one(trouble):
         body[k, events.X] = 0.5 * sim.container.size[0] + 0.1
     elif trouble in ("nan", "inf"):
         body[k, events.VY] = np.nan if trouble == "nan" else -np.inf
+    p = sim.particles
+    full_rows = np.ascontiguousarray(np.column_stack([body, p.radius, p.mass]))
+    assert full_rows.shape[1] == events.BODY_COLUMNS
     limit_x, limit_y = 0.5 * sim.container.size * (1 + 1e-12)
     later = sim.time  # where the drift left the disks: every one inside
-    verdicts = [
-        events.audit_in_box(later, body, s["geometry"], s["grid"], limit_x, limit_y, False, plain)
-        for plain in (True, False)
-    ]
-    (valid, strays, largest), (valid_full, _, largest_full) = verdicts
-    assert strays == 0
-    assert valid == valid_full == (trouble == "none")
-    assert largest == largest_full or (np.isnan(largest) and np.isnan(largest_full))
-
-
-def cd_gas() -> Simulation:
-    """The gas preset a little way in (disks of one radius, a box that is its cells' window)."""
-    import collidium as cd
-
-    return cd.load("gas").run(steps=3)
+    shared, full = (
+        events.audit_in_box(later, rows, s["geometry"], s["grid"], limit_x, limit_y, False, one)
+        for rows, one in ((body, True), (full_rows, False))
+    )
+    assert shared[1] == 0
+    assert shared[0] == full[0] == (trouble == "none")
+    assert shared[2] == full[2] or (np.isnan(shared[2]) and np.isnan(full[2]))
