@@ -121,7 +121,7 @@ def event_intervals(
             valid, strays, largest = events.audit_in_box(until, body, geometry, grid, limit_x,
                                                          limit_y, periodic,
                                                          window_is_vessel)  # fmt: skip
-            if valid and (strays == 0 or window_is_vessel):
+            if valid and strays == 0:  # none counted where the window is the vessel
                 continue
         strays = events.synchronise(until, body, event, geometry, grid, position, velocity)
         written, written_events = k + 1, processed
