@@ -13,7 +13,11 @@ W2  charged gas (all cores): microseconds per particle-step of the Coulomb sum, 
     gravity at equal N.
 W4  the charged-gas preset scaled to N = 1e4 .. 1e5 at its density, tree sum and exact collisions
     (all cores): microseconds per particle-step at its dt = 0.01 s, with the fixed and the
-    adaptive integrator, and the queues built per step (one per substep).
+    adaptive integrator, and the queues built or refreshed per step (one per substep).
+W4k a gas of 1e5 disks at packing 0.3 whose hundredth are ions in a uniform field, exact collisions
+    (all cores): milliseconds per step of dt = 0.01 s with the queue kept and the kicked disks
+    predicted again, beside the same steps with the queue built afresh at each kick and beside
+    the gas without the field; the disks predicted again per step.
 W3  the seed report's scenes (every preset): wall seconds per simulated second, quiet and beside
     one CPU-bound process per core (started and stopped here), and the ratio of the speeds.
 M   peak resident memory of an exact run at N = 1e6, and per particle.
@@ -175,8 +179,9 @@ def coulomb_costs(n: int, with_direct: bool, error_targets: int) -> dict[str, An
 def charged_exact_costs(n: int, steps: int) -> list[dict[str, Any]]:
     """W4: the charged-gas preset with n disks in a box grown to keep its density, summed by
     tree, exact collisions, all cores: wall microseconds per particle-step over ``steps`` steps
-    of dt = 0.01 s after a warm-up step, for each integrator; the drifts (queues built) per step
-    and the largest relative energy drift, as `collidium run` measures it."""
+    of dt = 0.01 s after a warm-up step, for each integrator; the queues built and refreshed
+    per step (one per drift) and the largest relative energy drift, as `collidium run` measures
+    it."""
     side = 20.0 * math.sqrt(n / 200)
     out = []
     for integrator in ("fixed", "adaptive"):
@@ -189,7 +194,8 @@ def charged_exact_costs(n: int, steps: int) -> list[dict[str, Any]]:
         drift = EnergyDrift()  # as `collidium run` measures it, every step
         sim.observers.append(drift)
         sim.run(steps=1)
-        built, start = sim._drift.rebuilds, time.perf_counter()
+        built, refreshed = sim._drift.rebuilds, sim._drift.refreshes
+        start = time.perf_counter()
         sim.run(steps=steps)
         seconds = time.perf_counter() - start
         out.append(
@@ -199,10 +205,54 @@ def charged_exact_costs(n: int, steps: int) -> list[dict[str, Any]]:
                 "threads": numba.get_num_threads(),
                 "us_per_particle_step": seconds / (steps * n) * 1e6,
                 "queues_per_step": (sim._drift.rebuilds - built) / steps,
+                "refreshes_per_step": (sim._drift.refreshes - refreshed) / steps,
                 "max_rel_drift": drift.max_rel_drift,
             }
         )
     return out
+
+
+def kicked_few_costs(n: int, share: float, steps: int, rounds: int = 3) -> dict[str, Any]:
+    """W4k: milliseconds per step (dt = 0.01 s, fixed integrator, all cores) of an n-disk gas at
+    packing 0.3 whose first ``share`` of disks carry 1 C in a field of 1 N/C: with the queue kept
+    across the kicks (the kicked disks predicted again), with it built afresh before each step,
+    and without the field. Each way runs ``steps`` steps one call apiece, in ``rounds`` rounds
+    alternated; the best round of each is kept."""
+    gas = packed_gas(n, dt=0.01)
+    p = gas.particles
+    charge = np.zeros(n)
+    charge[: int(share * n)] = 1.0
+    ions = cd.Particles(p.position, p.velocity, radius=p.radius, mass=p.mass, charge=charge)
+    field = [cd.UniformField(E=(1.0, 0.0))]
+    kept = cd.Simulation(gas.container, ions, dt=0.01, forces=field, integrator="fixed")
+    built = cd.Simulation(gas.container, ions.copy(), dt=0.01, forces=field, integrator="fixed")
+
+    def steps_of(sim: cd.Simulation, afresh: bool = False) -> float:
+        start = time.perf_counter()
+        for _ in range(steps):
+            if afresh:
+                sim._drift.forget()  # the next drift builds the queue again
+            sim.run(steps=1)
+        return (time.perf_counter() - start) / steps * 1e3
+
+    for sim in (kept, built, gas):
+        sim.run(steps=2)  # compile, build the queue
+    drift = kept._drift
+    before = (drift.refreshes, drift.repredicted)
+    best = {"kept": math.inf, "built": math.inf, "neutral": math.inf}
+    for _ in range(rounds):
+        best["kept"] = min(best["kept"], steps_of(kept))
+        best["built"] = min(best["built"], steps_of(built, afresh=True))
+        best["neutral"] = min(best["neutral"], steps_of(gas))
+    taken = rounds * steps
+    return {
+        "n": n,
+        "share": share,
+        "threads": numba.get_num_threads(),
+        "ms_per_step": best,
+        "refreshes_per_step": (drift.refreshes - before[0]) / taken,
+        "repredicted_per_step": (drift.repredicted - before[1]) / taken,
+    }
 
 
 def seed_scene_costs() -> list[dict[str, Any]]:
@@ -404,11 +454,24 @@ def main() -> None:
             (
                 f"W4 charged gas N={row['n']:,} {row['integrator']} ({row['threads']} thr)",
                 f"{row['us_per_particle_step']:.3g} us/p-step, "
-                f"{row['queues_per_step']:.3g} queues/step",
+                f"{row['queues_per_step']:.3g} built, {row['refreshes_per_step']:.3g} "
+                "refreshed/step",
                 "",
                 f"drift {row['max_rel_drift']:.1e}",
             )
         )
+
+    w4k = kicked_few_costs(10_000 if quick else 100_000, 0.01, 20 if quick else 50)
+    out["w4k_kicked_few"] = w4k
+    ms = w4k["ms_per_step"]
+    rows.append(
+        (
+            f"W4k gas N={w4k['n']:,}, 1% ions in a field ({w4k['threads']} thr)",
+            f"{ms['kept']:.3g} ms/step, {w4k['repredicted_per_step']:,.0f} predicted again",
+            f"built afresh {ms['built']:.3g}; no field {ms['neutral']:.3g}",
+            f"{ms['built'] / ms['kept']:.2f}x faster",
+        )
+    )
 
     w3 = seed_scene_costs()
     out["w3_seed_scenes"] = w3

@@ -28,18 +28,54 @@ def contacts(sim: cd.Simulation) -> int:
     return sim.counters.pair_collisions + sum(sim.counters.wall_hits.values())
 
 
-def test_force_kick_rebuilds_the_queue_every_step():
+def test_force_kick_refreshes_the_queue_every_step():
+    """Each step's kicks change every charged disk's velocity: the queue is kept, its disks all
+    predicted again (`events.refresh`)."""
     sim = cd.load("charged-gas", n=50, seed=2, integrator="fixed")
     sim.run(steps=20)
-    assert _engine(sim).rebuilds == 20
-    # The adaptive substeps that meet no contact fly compiled, without the queue; a substep
-    # that may meet contacts takes them in one drift, which rebuilds it.
+    engine = _engine(sim)
+    assert (engine.rebuilds, engine.refreshes, engine.repredicted) == (1, 19, 19 * 50)
+    # The adaptive substeps that meet no contact fly compiled, without the queue, and move the
+    # disks; a substep that may meet contacts takes them in one drift, which builds it again.
     sim.integrator = "adaptive"
     before = contacts(sim)
     sim.run(steps=20)
-    rebuilds = _engine(sim).rebuilds - 20
+    rebuilds = _engine(sim).rebuilds - 1
     assert contacts(sim) > before
     assert 0 < rebuilds < 20 * sim._integrator.substeps
+
+
+@pytest.mark.parametrize("share", [0.02, 1.0])
+def test_a_queue_refreshed_after_kicks_meets_the_contacts_of_one_built_again(share):
+    """After a kick of a few velocities (each kicked disk put in its place in the heap) or of all
+    (the heap ordered again as a whole), the engine predicts the kicked disks again and keeps the
+    other events (`events.refresh`). The run meets the contacts of one whose queue is built
+    afresh after each kick, and ends where it does to within the round-off that every velocity
+    changed in its last bit grows to over the same run (each disk kept from its own time, not the
+    kick's, rounds differently)."""
+    runs = []
+    for fresh, nudged in ((False, False), (True, False), (True, True)):
+        sim = cd.load("gas", n=400, seed=5, dt=0.05).run(steps=1)
+        if nudged:
+            velocity = sim.particles.velocity
+            velocity[...] = np.nextafter(velocity, np.where(velocity > 0, np.inf, -np.inf))
+        kicks, kicked = np.random.default_rng(6), 0
+        for _ in range(10):
+            chosen = kicks.random(sim.particles.n) < share
+            sim.particles.velocity[chosen] *= 1.0 + kicks.uniform(-0.05, 0.05, (chosen.sum(), 1))
+            kicked += chosen.sum()
+            if fresh:
+                sim._drift.forget()
+            sim.run(steps=1)
+        runs.append(sim)
+    kept, built, nudged_run = runs
+    engine = _engine(kept)
+    assert (engine.rebuilds, engine.refreshes, engine.repredicted) == (1, 10, kicked)
+    assert _engine(built).rebuilds == 11
+    assert kept.counters == built.counters
+    assert kept.counters.pair_collisions > 500
+    growth = np.abs(nudged_run.particles.position - built.particles.position).max()
+    assert 0.0 < np.abs(kept.particles.position - built.particles.position).max() < 100 * growth
 
 
 def test_user_edit_between_runs_is_seen():
@@ -48,7 +84,7 @@ def test_user_edit_between_runs_is_seen():
     sim.particles.velocity[:] = 0.0  # stop both: no collision may happen any more
     sim.run(time=1.0)
     assert sim.counters.pair_collisions == 0
-    assert _engine(sim).rebuilds == 2
+    assert (_engine(sim).rebuilds, _engine(sim).refreshes) == (1, 1)
 
 
 def test_report_interval_does_not_change_an_exact_force_free_run():

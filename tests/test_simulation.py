@@ -692,13 +692,16 @@ def test_steps_taken_one_by_one_skip_the_engine_check_only_where_nothing_else_ra
 
 def test_a_drift_that_refuses_to_start_takes_the_vouch_with_it():
     """A drift that refuses a runaway state consumes the run loop's vouch: the particles a user
-    then changes are checked at the next run, and the queue is built again for them."""
+    then changes are checked at the next run, and the one whose velocity changed is predicted
+    again."""
     sim = cd.load("gas", n=60, seed=4).run(steps=2)
-    rebuilds, kept = sim._drift.rebuilds, sim.particles.velocity[0].copy()
-    sim._drift.vouch()
+    drift, kept = sim._drift, sim.particles.velocity[0].copy()
+    counts = (drift.rebuilds, drift.refreshes, drift.repredicted)
+    drift.vouch()
     sim.particles.velocity[0] = 1e300
     with pytest.raises(cd.SimulationError, match="run away"):
         sim.run(steps=1)
     sim.particles.velocity[0] = -kept
     sim.run(steps=1)
-    assert sim._drift.rebuilds == rebuilds + 1
+    after = (drift.rebuilds, drift.refreshes, drift.repredicted)
+    assert after == (counts[0], counts[1] + 1, counts[2] + 1)

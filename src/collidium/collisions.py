@@ -3,8 +3,9 @@
 Three modes:
 
 - `ExactCollisions` (``"exact"``): event-driven free flight with exact elastic pair and wall
-  collisions (`kernels/events.py`). Its event queue is kept between steps and rebuilt only when the
-  state was changed from outside (a force kick, a user edit).
+  collisions (`kernels/events.py`). Its event queue is kept between steps: where a force's kick
+  or a user changed velocities, the particles whose velocity changed are predicted again; it is
+  built again only where positions, radii or masses changed.
 - `StepCollisions` (``"step"``): the seed's method: a plain drift, walls folded back exactly, then
   overlapping approaching pairs resolved one by one in index order (`kernels/stepper.py`).
 - `NoCollisions` (``"off"``): disks pass through each other; walls still reflect exactly.
@@ -257,9 +258,9 @@ class Drift(Protocol):
         further; other modes leave it as it is.
         """
 
-    def flies(self, particles: Particles, tally: Tally, fall: FloatArray) -> bool:
-        """Whether `fly` may take steps now, without forces or under a uniform gravity ``fall``
-        (2,) in m/s^2 (zero for none) that the mode carries."""
+    def flies(self, particles: Particles, vessel: Vessel, tally: Tally, fall: FloatArray) -> bool:
+        """Whether `fly` may take steps now in ``vessel``, without forces or under a uniform
+        gravity ``fall`` (2,) in m/s^2 (zero for none) that the mode carries."""
 
     def fly(
         self,
@@ -373,7 +374,7 @@ class _Stateless:
     def vouch(self) -> None:
         """Nothing checked (`Drift.vouch`)."""
 
-    def flies(self, particles: Particles, tally: Tally, fall: FloatArray) -> bool:
+    def flies(self, particles: Particles, vessel: Vessel, tally: Tally, fall: FloatArray) -> bool:
         """Never: each step is its own call (`Drift.flies`)."""
         return False
 
@@ -551,9 +552,11 @@ class ExactCollisions:
 
     The engine keeps lazily updated positions of its own, in its own order
     (`collidium.kernels.events`); ``particles.position`` and ``particles.velocity`` receive the
-    state at the end of each drift. If the particles differ from what the engine last wrote (a
-    force kick, an edit by the user), the queue is rebuilt from them. Under a uniform gravity
-    the free flights are exact parabolas (`carries_fall`), so the queue lives on then too.
+    state at the end of each drift. Where only velocities differ from what the engine last wrote
+    (a force's kick, an edit by the user), the particles whose velocity changed are predicted
+    again and the other events kept (`collidium.kernels.events.refresh`); where positions, radii
+    or masses differ, the queue is built again from the particles. Under a uniform gravity the
+    free flights are exact parabolas (`carries_fall`), so the queue lives on then too.
     """
 
     carries_fall = True
@@ -568,6 +571,9 @@ class ExactCollisions:
         self.events = 0
         #: Times the event queue was built from scratch.
         self.rebuilds = 0
+        #: Times it was kept with the particles whose velocity changed predicted again, and how
+        #: many such particles in all.
+        self.refreshes = self.repredicted = 0
         #: Events per particle between re-sorts of the engine's memory by cell (speed only).
         self.sort_interval = events.SORT_INTERVAL
         #: The contact log of drifts that are given none (never written: no forces).
@@ -580,7 +586,9 @@ class ExactCollisions:
     def state(self) -> dict[str, np.ndarray]:
         """The event queue and lazily updated positions, and the event counters."""
         out: dict[str, np.ndarray] = {
-            "events": np.array([self.events, self.rebuilds], dtype=np.int64),
+            "events": np.array(
+                [self.events, self.rebuilds, self.refreshes, self.repredicted], dtype=np.int64
+            ),
             "event_codes": np.array([_EVENT_CODES]),
         }
         if self._state is not None:
@@ -595,7 +603,9 @@ class ExactCollisions:
     def load_state(self, arrays: dict[str, np.ndarray]) -> None:
         """Continue from a saved queue (or rebuild it at the next drift if none was saved, or
         one of another layout)."""
-        self.events, self.rebuilds = (int(x) for x in arrays["events"])
+        counters = [int(x) for x in arrays["events"]]
+        counters += [0] * (4 - len(counters))  # saved before the queue was refreshed: none
+        self.events, self.rebuilds, self.refreshes, self.repredicted = counters
         queue = {k.removeprefix("queue/"): v for k, v in arrays.items() if k.startswith("queue/")}
         queue.setdefault("piston", np.empty(0))  # saved before pistons: none
         usable = (
@@ -613,13 +623,22 @@ class ExactCollisions:
 
     def vouch(self) -> None:
         """Skip, at the next drift, the check that the particles are as the last one wrote them
-        (`Drift.vouch`): a pass over every particle in slot order, reading each at random, 1.2-1.4
-        ms at 1e5 disks on two cores."""
+        (`Drift.vouch`): `collidium.kernels.events.refresh`'s pass over every particle in slot
+        order, reading each at random, 0.3-0.5 ms at 1e5 disks on two cores."""
         self._vouched = True
 
-    def _is_current(
-        self, particles: Particles, piston: FloatArray, fall: FloatArray, vouched: bool = False
+    def _up_to_date(
+        self,
+        particles: Particles,
+        vessel: Vessel,
+        piston: FloatArray,
+        fall: FloatArray,
+        vouched: bool = False,
     ) -> bool:
+        """Whether the queue holds the particles, now brought up to date with any velocities
+        changed since the last drift wrote them (`collidium.kernels.events.refresh`); False where
+        it must be built again: none kept, another number of particles, gravity or piston, or
+        positions, radii or masses changed."""
         s = self._state
         if s is None or s["body"].shape[0] != particles.n:
             return False
@@ -630,12 +649,13 @@ class ExactCollisions:
         if vouched:
             return True
         p = particles
-        matches = events.matches_in_chunks if _many(p) else events.matches
-        synced = matches(
-            self._synced_at, s["body"], s["event"], s["geometry"],
-            p.position, p.velocity, p.radius, p.mass,
-        )  # fmt: skip
-        return bool(synced)
+        refresh = events.refresh_in_chunks if _many(p) else events.refresh
+        arguments = (*_queue(s, vessel), p.position, p.velocity, p.radius, p.mass)
+        changed = int(refresh(self._synced_at, *arguments))
+        if changed > 0:
+            self.refreshes += 1
+            self.repredicted += changed
+        return changed >= 0
 
     def _rebuild(
         self,
@@ -733,7 +753,7 @@ class ExactCollisions:
         vouched, self._vouched = self._vouched and self._synced_at == now, False
         fall = _NO_FALL if fall is None else fall
         _refuse_runaway(particles, vessel, dt, fall)
-        if not self._is_current(particles, tally.piston, fall, vouched):
+        if not self._up_to_date(particles, vessel, tally.piston, fall, vouched):
             self._state = self._rebuild(particles, vessel, now, tally.piston, fall)
             self.rebuilds += 1
         s = self._state
@@ -767,15 +787,15 @@ class ExactCollisions:
             # Disks have spread out of the cells' window: a larger one at the next drift.
             self._spare, self._state = self._state, None
 
-    def flies(self, particles: Particles, tally: Tally, fall: FloatArray) -> bool:
-        """Whether `fly` may take steps now: the queue is built for this ``fall``, nobody
-        changed the particles since it wrote them, and the particles are fewer than
-        `collidium.kernels.audit.PARALLEL_FROM` (`Drift.flies`). With more, a step takes
+    def flies(self, particles: Particles, vessel: Vessel, tally: Tally, fall: FloatArray) -> bool:
+        """Whether `fly` may take steps now: the queue is built for this ``fall`` and holds the
+        particles (brought up to date with velocities changed since it wrote them), and they are
+        fewer than `collidium.kernels.audit.PARALLEL_FROM` (`Drift.flies`). With more, a step takes
         milliseconds, its Python is nothing beside them, and the run loop's audit and the
         engine's passes over every particle run on every core where the flight's would run on
         one (a 1e5-disk gas's step took 7-10% longer flown, before those passes were
         parallel)."""
-        return not _many(particles) and self._is_current(particles, tally.piston, fall)
+        return not _many(particles) and self._up_to_date(particles, vessel, tally.piston, fall)
 
     def fly(
         self,
@@ -791,7 +811,7 @@ class ExactCollisions:
         """Steps in one compiled call (`Drift.fly`,
         `collidium.kernels.event_flights.event_intervals`). The record holds no piston: with
         one, the simulation asks for no step of it (`Simulation._reads_state`)."""
-        if not self.flies(particles, tally, fall):
+        if not self.flies(particles, vessel, tally, fall):
             return 0
         s = self._state
         assert s is not None

@@ -128,7 +128,9 @@ class Integrator:
         (`_flies_with_forces`)."""
         if field.kicks:
             return self._flies_with_forces(particles, vessel, field, drift)
-        return (not field.active or field.falls_alone) and drift.flies(particles, tally, field.fall)
+        return (not field.active or field.falls_alone) and drift.flies(
+            particles, vessel, tally, field.fall
+        )
 
     def fly(
         self,

@@ -295,8 +295,8 @@ def test_engine_matches_twin_across_cell_crossings(rng):
         events.run_events,
         events.synchronise,
         events.synchronise_in_chunks,
-        events.matches,
-        events.matches_in_chunks,
+        events.refresh,
+        events.refresh_in_chunks,
         audit._in_chunks,
     ],
 )
@@ -316,7 +316,9 @@ def _large_gas(rng, n: int) -> Simulation:
 
 def test_the_parallel_passes_write_and_check_what_the_serial_ones_do(rng):
     """`synchronise_in_chunks` writes the same bits and strays as `synchronise`, and
-    `matches_in_chunks` answers as `matches`, also to a change in the first or the last chunk."""
+    `refresh_in_chunks` leaves the queue that `refresh` leaves: after a change of velocity in the
+    first or the last chunk, of many velocities, of none, and of a position (the queue to be built
+    again, -1)."""
     sim = _large_gas(rng, 5 * 4096 + 77)  # five chunks, the last one longer
     sim.run(steps=2)
     s, p = sim._drift._state, sim.particles
@@ -329,15 +331,45 @@ def test_the_parallel_passes_write_and_check_what_the_serial_ones_do(rng):
         written.append((position.tobytes(), velocity.tobytes(), strays))
     assert written[0] == written[1]
     assert not np.isnan(np.frombuffer(written[0][0])).any()
-    arguments = (sim.time, s["body"], s["event"], s["geometry"])
-    for index in (int(s["event"][0, events.IDENT]), int(s["event"][-1, events.IDENT]), None):
-        if index is not None:
-            p.velocity[index, 1] = np.nextafter(p.velocity[index, 1], np.inf)
-        answers = {bool(matches(*arguments, p.position, p.velocity, p.radius, p.mass))
-                   for matches in (events.matches, events.matches_in_chunks)}  # fmt: skip
-        assert answers == {index is None}
-        if index is not None:
-            p.velocity[index, 1] = np.nextafter(p.velocity[index, 1], -np.inf)
+    first, last = int(s["event"][0, events.IDENT]), int(s["event"][-1, events.IDENT])
+    many = rng.random(p.n) < 0.1
+    none = np.array([], dtype=int)
+    for changed, expected in (([first], 1), ([last], 1), (many, many.sum()), (none, 0)):
+        velocity = p.velocity.copy()
+        velocity[changed, 1] = np.nextafter(velocity[changed, 1], np.inf)
+        for moved in (False, True):
+            position = p.position.copy()
+            position[last, 0] = np.nextafter(position[last, 0], 0.0) if moved else position[last, 0]
+            left = []
+            for refresh in (events.refresh, events.refresh_in_chunks):
+                queue = {name: np.copy(array) for name, array in s.items()}
+                answer = refresh(sim.time, *collisions._queue(queue, sim.container), position,
+                                 velocity, p.radius, p.mass)  # fmt: skip
+                left.append((answer, [queue[name].tobytes() for name in collisions._QUEUE_ARRAYS]))
+            if moved:  # the rows are to be built again: only the answer counts
+                assert left[0][0] == left[1][0] == -1
+            else:
+                assert left[0] == left[1]
+                assert left[0][0] == expected
+
+
+@pytest.mark.parametrize("shared", [True, False])
+def test_a_queue_is_refreshed_for_new_velocities_alone(rng, shared):
+    """`refresh` takes in a changed velocity (1 slot changed); a changed position, radius or mass
+    asks for the queue to be built again (-1), with rows of one radius and mass (checked apart,
+    in particle order) and with full rows."""
+    sim = _large_gas(rng, 500) if shared else _dense_gas("reflecting", rng)
+    sim.run(steps=1)
+    s, p = sim._drift._state, sim.particles
+    assert (s["body"].shape[1] == events.SHARED_BODY_COLUMNS) == shared
+    last = int(s["event"][-1, events.IDENT])  # checked last, in slot order
+    for name, expected in (("velocity", 1), ("position", -1), ("radius", -1), ("mass", -1)):
+        queue = {key: np.copy(array) for key, array in s.items()}
+        given = {key: getattr(p, key).copy() for key in ("position", "velocity", "radius", "mass")}
+        row = given[name][last : last + 1].reshape(-1)
+        row[0] = np.nextafter(row[0], 0.0)
+        answer = events.refresh(sim.time, *collisions._queue(queue, sim.container), *given.values())
+        assert answer == expected, name
 
 
 def test_a_large_gas_runs_the_same_bits_with_its_passes_in_parallel_or_not(rng, monkeypatch):
@@ -384,6 +416,8 @@ def test_a_queue_built_again_from_the_slots_before_runs_as_a_fresh_one(rng):
         kicks = np.random.default_rng(4)
         for _ in range(4):
             sim.particles.velocity *= 1.0 + kicks.uniform(-0.01, 0.01, (sim.particles.n, 1))
+            # A moved disk: the queue is built again, not refreshed (`events.refresh`).
+            sim.particles.position[0] *= 1.0 - 2**-40
             if fresh:
                 sim._drift._state = sim._drift._spare = None
             sim.run(steps=1)

@@ -17,6 +17,8 @@ Design (Rapaport; Donev, Torquato & Stillinger; Bannerman's DynamO for the memor
 - Cells are at least one largest diameter wide, so a particle's possible partners are in the
   9 cells around it (found arithmetically, with the periodic wrap); crossing into another cell
   re-predicts it against its new neighbours.
+- A kick between drifts re-predicts only the particles whose velocity it changed (`refresh`), as
+  a collision does.
 
 Memory layout. At 1e5 particles and more the engine waits on memory, not arithmetic, so:
 
@@ -340,7 +342,13 @@ def _heap_build(keys, items, where) -> None:
     for s in range(n):
         items[s] = s
         where[s] = s
-    for s in range((n - 2) // ARITY, -1, -1):
+    _heapify(keys, items, where)
+
+
+@uncounted()
+def _heapify(keys, items, where) -> None:
+    """Restore heap order to ``keys`` and ``items`` as they lie, ``where`` kept (O(N))."""
+    for s in range((keys.shape[0] - 2) // ARITY, -1, -1):
         _sift_down(s, keys[s], items[s], keys, items, where)
 
 
@@ -731,8 +739,8 @@ def rebuild_in_chunks(
     now, body, geometry, grid, head, next_, event, keys, items, segments, piston
 ) -> None:
     """`rebuild` with its passes over every slot in parallel chunks, for many particles
-    (`audit.PARALLEL_FROM`): under forces the queue is built again at every substep. Each
-    slot's prediction is its own, so any number of threads builds the same queue."""
+    (`audit.PARALLEL_FROM`). Each slot's prediction is its own, so any number of threads builds
+    the same queue."""
     n = body.shape[0]
     chunks = chunk_count(n)
     for p in numba.prange(chunks):
@@ -1131,8 +1139,9 @@ def load(position, velocity, radius, mass, body, event) -> None:
     particle ``event[k, IDENT]``.
 
     The slots keep their particles from queue to queue (a fresh engine's slot k holds particle
-    k): under forces the queue is built again at every substep, and the slots are then still
-    nearly in cell order (`rebuild`).
+    k): a queue built again where the particles moved since the last (a drift that left disks
+    outside the cells' window, the compiled substeps' flights) finds the slots still nearly in
+    cell order (`rebuild`).
 
     Parameters
     ----------
@@ -1226,39 +1235,114 @@ def _synchronise_between(start, stop, now, body, event, geometry, grid, position
     return strays
 
 
+#: ``event[k, KEPT]`` of a slot whose velocity changed (`_take_in_between`) until `refresh`
+#: predicts it again.
+REPREDICT = -2
+
+
 @uncounted(nogil=True)
-def matches(now, body, event, geometry, position, velocity, radius, mass) -> bool:
-    """True if the particles are exactly what `synchronise` wrote at ``now`` (s), with the
-    engine's radii and masses: nobody changed them since, and the queue is still valid."""
-    return _matches_between(0, body.shape[0], now, body, event, geometry, position, velocity,
-                            radius, mass)  # fmt: skip
+def refresh(now, body, geometry, grid, head, next_, event, keys, items, segments, piston,
+            position, velocity, radius, mass) -> int:  # fmt: skip
+    """Bring the queue up to date with the particles at ``now`` (s), the time `synchronise` last
+    wrote them, where only velocities changed since (a kick, a user's edit): each slot whose
+    velocity changed starts again at ``now`` with the new one and is predicted again; the others
+    keep their rows and events.
+
+    That is exact, as after a collision: the changed slot's collision count goes up, so that
+    events predicted against it are stale when they come, and its own prediction searches every
+    neighbour, so that it finds any contact that comes before their own next events. The heap is
+    then ordered again (`_predict_marked_between`).
+
+    Parameters
+    ----------
+    position, velocity : ndarray, shape (N, 2)
+        The particles' positions (m) and velocities (m/s), by particle.
+    radius, mass : ndarray, shape (N,)
+        In m and kg.
+
+    Returns
+    -------
+    int
+        How many slots changed (0: the queue was up to date), or -1 where a position, radius or
+        mass is not the engine's: the queue must then be built again (`load`, `rebuild`, which
+        set every row: some may have been changed here).
+    """
+    n = body.shape[0]
+    changed = _take_in_between(0, n, now, body, event, geometry, position, velocity, radius,
+                               mass)  # fmt: skip
+    if changed > 0:
+        _predict_marked_between(0, n, now, body, geometry, grid, head, next_, event, keys,
+                                segments, piston)  # fmt: skip
+        _heapify(keys, items, event[:, WHERE])
+    return changed
 
 
 @numba.njit(cache=True, parallel=True, nogil=True)
-def matches_in_chunks(now, body, event, geometry, position, velocity, radius, mass) -> bool:
-    """`matches` in parallel chunks of slots, for many particles (`audit.PARALLEL_FROM`)."""
+def refresh_in_chunks(now, body, geometry, grid, head, next_, event, keys, items, segments,
+                      piston, position, velocity, radius, mass) -> int:  # fmt: skip
+    """`refresh` with its passes over every slot in parallel chunks, for many particles
+    (`audit.PARALLEL_FROM`). Each slot's row and prediction are its own, so any number of
+    threads leaves the same queue."""
     n = body.shape[0]
     chunks = chunk_count(n)
-    same = np.zeros(chunks, dtype=np.bool_)
+    changed = np.zeros(chunks, dtype=np.int64)
     for p in numba.prange(chunks):
-        same[p] = _matches_between(p * n // chunks, (p + 1) * n // chunks, now, body, event,
-                                   geometry, position, velocity, radius, mass)  # fmt: skip
-    return bool(same.all())
+        changed[p] = _take_in_between(p * n // chunks, (p + 1) * n // chunks, now, body, event,
+                                      geometry, position, velocity, radius, mass)  # fmt: skip
+    if (changed < 0).any():
+        return -1
+    total = changed.sum()
+    if total > 0:
+        for p in numba.prange(chunks):
+            _predict_marked_between(p * n // chunks, (p + 1) * n // chunks, now, body, geometry,
+                                    grid, head, next_, event, keys, segments, piston)  # fmt: skip
+        _heapify(keys, items, event[:, WHERE])
+    return total
 
 
 @inlined
-def _matches_between(start, stop, now, body, event, geometry, position, velocity, radius, mass):
-    """`matches` for the slots ``start`` to ``stop - 1``."""
+def _take_in_between(start, stop, now, body, event, geometry, position, velocity, radius, mass):
+    """Start the slots ``start`` to ``stop - 1`` whose particle's velocity is no longer the one
+    `synchronise` wrote at ``now`` (s) again there with the new one, marked `REPREDICT`, their
+    collision counts raised. Returns how many, or -1 at the first whose position, radius or mass
+    is not the engine's. Radii and masses that the disks share are checked apart, for the
+    particles ``start`` to ``stop - 1`` in their own order: read from each slot's particle they
+    would be two more reads at random, which cost more than the rest of the pass."""
+    shared = body.shape[1] == SHARED_BODY_COLUMNS
+    if shared:
+        for i in range(start, stop):
+            if radius[i] != geometry[SHARED_RADIUS] or mass[i] != geometry[SHARED_MASS]:
+                return -1
+    changed = 0
     for k in range(start, stop):
         i = event[k, IDENT]
         x, y, vx, vy = _at(k, now, body, geometry)
-        if (
-            position[i, 0] != x
-            or position[i, 1] != y
-            or velocity[i, 0] != vx
-            or velocity[i, 1] != vy
-            or radius[i] != _radius(k, body, geometry)
-            or mass[i] != _mass(k, body, geometry)
-        ):
-            return False
-    return True
+        if position[i, 0] != x or position[i, 1] != y:
+            return -1
+        if not shared and (radius[i] != body[k, RADIUS] or mass[i] != body[k, MASS]):
+            return -1
+        if velocity[i, 0] != vx or velocity[i, 1] != vy:
+            body[k, X] = x
+            body[k, Y] = y
+            body[k, VX] = velocity[i, 0]
+            body[k, VY] = velocity[i, 1]
+            body[k, STAMP] = now
+            event[k, COUNT] += 1
+            event[k, KEPT] = REPREDICT
+            changed += 1
+    return changed
+
+
+@inlined
+def _predict_marked_between(start, stop, now, body, geometry, grid, head, next_, event, keys,
+                            segments, piston) -> None:  # fmt: skip
+    """Predict the slots ``start`` to ``stop - 1`` marked `REPREDICT` again, each event time
+    written at the slot's place in the heap, whose order `_heapify` then restores: a pass over
+    the heap that stops at once where a node's children are not earlier, cheaper than moving
+    each changed slot to its place alone but where a few hundred of 1e5 changed."""
+    ident, cell_of, count, where = _slot_views(event)
+    for k in range(start, stop):
+        if event[k, KEPT] == REPREDICT:
+            keys[where[k]] = _predict_not_inlined(k, now, body, ident, geometry, grid, cell_of,
+                                                  head, next_, count, event, segments,
+                                                  piston)  # fmt: skip
