@@ -17,7 +17,10 @@ from types import FrameType
 from typing import Any
 
 import numba
+from llvmlite import ir
+from numba.core import cgutils, types
 from numba.core import event as numba_event
+from numba.extending import intrinsic
 
 
 def uncounted(**options: Any) -> Any:
@@ -118,3 +121,32 @@ def interrupts_outside_compiling() -> Iterator[None]:
     finally:
         numba_event.unregister("numba:compiler_lock", depth)
         signal.signal(signal.SIGINT, previous)
+
+
+def _prefetch(typingctx: Any, array: Any, index: Any) -> Any:
+    """Ask the processor for the cache line of ``array[index]`` (an index within the array), to
+    be read soon: LLVM's ``llvm.prefetch``, which changes nothing else. A chain of loads that
+    each wait for the one before (the heap's levels, `collidium.kernels.events`) can then ask for
+    the next level's lines while the compares of this one run."""
+    signature = types.void(array, index)
+
+    def codegen(context: Any, builder: Any, sig: Any, args: Any) -> Any:
+        array_type = sig.args[0]
+        view = context.make_array(array_type)(context, builder, args[0])
+        pointer = cgutils.get_item_pointer(
+            context, builder, array_type, view, [args[1]], wraparound=False
+        )
+        word, byte = ir.IntType(32), ir.IntType(8).as_pointer()
+        # One declaration per module, whatever the arrays' types: hence the byte pointer, its
+        # name mangled as this LLVM wants it.
+        function = builder.module.declare_intrinsic(
+            "llvm.prefetch", [byte], ir.FunctionType(ir.VoidType(), [byte, word, word, word])
+        )
+        builder.call(function, [builder.bitcast(pointer, byte), word(0), word(3), word(1)])
+        return context.get_dummy_value()  # above: a read, kept in every cache level, of data
+
+    return signature, codegen
+
+
+#: `_prefetch` as kernels call it, ``prefetch(array, index)`` (typed for them by numba).
+prefetch: Any = intrinsic(_prefetch)
