@@ -142,19 +142,20 @@ def test_what_a_kernel_without_reference_counting_calls_sets_its_own():
 
 
 def test_prefetch_asks_for_the_lines_of_arrays_of_any_type_and_changes_nothing():
-    """`prefetch` compiles for arrays of two types in one kernel (one declaration of LLVM's
-    intrinsic for both) into the processor's prefetch, and the values read are as they were."""
+    """`prefetch` compiles for arrays of two types and dimensions in one kernel (one declaration
+    of LLVM's intrinsic for all) into the processor's prefetch, and the values read are as they
+    were."""
 
     @numba.njit
     def summed(a, b):
         total = 0.0
         for i in range(a.shape[0]):
             prefetch(a, i)
-            prefetch(b, i)
-            total += a[i] + b[i]
+            prefetch(b, (i, 1))
+            total += a[i] + b[i, 1]
         return total
 
-    a, b = np.arange(100.0), np.arange(100, dtype=np.int32)
-    assert summed(a, b) == a.sum() + b.sum()
+    a, b = np.arange(100.0), np.arange(300, dtype=np.int32).reshape(100, 3)
+    assert summed(a, b) == a.sum() + b[:, 1].sum()
     assembly = next(iter(summed.inspect_asm().values()))
     assert "prefetch" in assembly or "prfm" in assembly  # x86, ARM

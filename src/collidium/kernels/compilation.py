@@ -124,8 +124,9 @@ def interrupts_outside_compiling() -> Iterator[None]:
 
 
 def _prefetch(typingctx: Any, array: Any, index: Any) -> Any:
-    """Ask the processor for the cache line of ``array[index]`` (an index within the array), to
-    be read soon: LLVM's ``llvm.prefetch``, which changes nothing else. A chain of loads that
+    """Ask the processor for the cache line of ``array[index]`` (an index within the array, a
+    tuple of them for an array of more dimensions), to be read soon: LLVM's ``llvm.prefetch``,
+    which changes nothing else. A chain of loads that
     each wait for the one before (the heap's levels, `collidium.kernels.events`) can then ask for
     the next level's lines while the compares of this one run."""
     signature = types.void(array, index)
@@ -133,8 +134,16 @@ def _prefetch(typingctx: Any, array: Any, index: Any) -> Any:
     def codegen(context: Any, builder: Any, sig: Any, args: Any) -> Any:
         array_type = sig.args[0]
         view = context.make_array(array_type)(context, builder, args[0])
+        index_type = sig.args[1]
+        if isinstance(index_type, types.BaseTuple):
+            kinds: Any = index_type  # iterates over its members' types
+            values = cgutils.unpack_tuple(builder, args[1], len(kinds))
+            given = list(zip(values, kinds, strict=True))
+        else:
+            given = [(args[1], index_type)]
+        indices = [context.cast(builder, value, kind, types.intp) for value, kind in given]
         pointer = cgutils.get_item_pointer(
-            context, builder, array_type, view, [args[1]], wraparound=False
+            context, builder, array_type, view, indices, wraparound=False
         )
         word, byte = ir.IntType(32), ir.IntType(8).as_pointer()
         # One declaration per module, whatever the arrays' types: hence the byte pointer, its

@@ -286,6 +286,18 @@ def _prefetch_below(first, keys, items) -> None:
 
 
 @inlined
+def _prefetch_following(keys, items, body, event) -> None:
+    """Ask for the rows of the slot whose event is most likely the next (the earliest of the
+    root's children: an event predicted meanwhile rarely comes before it, a million disks' events
+    being so close in time), in a heap of `PREFETCH_FROM` slots or more: its rows then come
+    while this event is taken."""
+    if keys.shape[0] >= PREFETCH_FROM:
+        following = items[_least_of_eight(keys, 1)[0]]
+        prefetch(body, (following, 0))
+        prefetch(event, (following, 0))
+
+
+@inlined
 def _least(a, b, ia, ib):
     """The lesser of keys a and b with its index (ia, ib); a on a tie. Selects, not branches."""
     later = b < a
@@ -904,6 +916,7 @@ def run_events(
         if t > until:
             break
         k = earliest(keys, items, ident)
+        _prefetch_following(keys, items, body, event)
         processed += 1
         since_sort += 1
         if t > instant:
