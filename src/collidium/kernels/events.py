@@ -275,7 +275,8 @@ def _sift_down(slot, key, item, keys, items, where) -> None:
 def _prefetch_below(first, keys, items) -> None:
     """Ask for the lines of the children of the ``ARITY`` nodes from ``first`` (keys and items),
     before their least is known, in a heap of `PREFETCH_FROM` slots or more: at a million disks
-    the sift down waited on each level's line in turn, and now waits on about one."""
+    the sift down waited on each level's lines in turn; asked for ahead, they come while the
+    level above is compared."""
     n = keys.shape[0]
     if n < PREFETCH_FROM:
         return
@@ -1372,8 +1373,9 @@ def _predict_marked_between(start, stop, now, body, geometry, grid, head, next_,
                             segments, piston) -> None:  # fmt: skip
     """Predict the slots ``start`` to ``stop - 1`` marked `REPREDICT` again, each event time
     written at the slot's place in the heap, whose order `_heapify` then restores: a pass over
-    the heap that stops at once where a node's children are not earlier, cheaper than moving
-    each changed slot to its place alone but where a few hundred of 1e5 changed."""
+    the heap that stops at once where a node's children are not earlier. Moving each changed
+    slot to its place alone was cheaper only where fewer than a few hundred of 1e5 changed
+    (ARCHITECTURE.md, "A kick and the event queue")."""
     ident, cell_of, count, where = _slot_views(event)
     for k in range(start, stop):
         if event[k, KEPT] == REPREDICT:
