@@ -186,6 +186,31 @@ def test_slot_order_does_not_change_the_outcome(rng, boundary):
     np.testing.assert_array_equal(a.tally.counts, b.tally.counts)
 
 
+@pytest.mark.slow
+def test_a_heap_large_enough_to_prefetch_takes_the_same_events_in_any_slot_order():
+    """In a large heap the event loop and the heap's sift down ask for lines ahead
+    (`_prefetch_following` from `events.PREFETCH_EVENTS_FROM` disks, `_prefetch_below` from
+    `events.PREFETCH_FROM`): reading where they guess the next events' slots lie, they change
+    nothing of the run, which is the same bit for bit with the slots sorted by cell every event
+    per particle or never."""
+    n = max(events.PREFETCH_FROM, events.PREFETCH_EVENTS_FROM)
+    side = int(np.ceil(np.sqrt(n)))
+    runs = []
+    for interval in (1, 10**9):
+        rng = np.random.default_rng(3)
+        position = jittered_lattice(side, float(side), 0.3, rng)
+        particles = Particles(position, rng.normal(0, 3, position.shape), radius=0.3)
+        sim = Simulation(Box(float(side), float(side), "periodic"), particles, dt=0.3)
+        sim._drift.sort_interval = interval
+        sim.run(steps=1)
+        runs.append(sim)
+    a, b = runs
+    assert a._drift.events > 2 * n  # a sort or more in the first run
+    np.testing.assert_array_equal(a.particles.position, b.particles.position)
+    np.testing.assert_array_equal(a.particles.velocity, b.particles.velocity)
+    np.testing.assert_array_equal(a.tally.counts, b.tally.counts)
+
+
 def _by_particle(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """The engine's state indexed by particle instead of slot: body rows, the particle of each
     event's partner and kept contact (-1 for none, wall and cell codes kept), event times."""
