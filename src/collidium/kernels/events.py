@@ -23,9 +23,11 @@ Design (Rapaport; Donev, Torquato & Stillinger; Bannerman's DynamO for the memor
 Memory layout. At 1e5 particles and more the engine waits on memory, not arithmetic, so:
 
 - Particles live in *slots* of the engine's own order, sorted by cell and re-sorted every few
-  events per particle (`sort_slots`), so that neighbours sit close in memory. ``ident[k]`` is the
-  particle (its index in `collidium.state.Particles`) in slot k. Every tie between equal event
-  times is broken by ident, never by slot, so the outcome does not depend on the slot order.
+  events per particle (`sort_slots`), so that neighbours sit close in memory; the cells are
+  taken in square tiles (`TILE`), so that the rows above and below are close too. ``ident[k]``
+  is the particle (its index in `collidium.state.Particles`) in slot k. Every tie between equal
+  event times is broken by ident, never by slot, so the outcome does not depend on the slot
+  order.
 - Everything a prediction reads of a neighbour is one row of ``body``:
   ``x, y, vx, vy, stamp`` (m, m/s, s) and, when the disks differ, ``radius, mass`` (m, kg), 56
   bytes. When all disks share one radius and one mass, ``geometry`` holds them and the row is 40
@@ -109,15 +111,11 @@ LOG_COLUMNS = 17
 #: third as deep as a binary one.
 ARITY = 8
 
-#: Slots from which the heap's sift down asks for the next level's lines ahead (`_prefetch_below`):
-#: its keys and items, 3 MB, then outgrow a core's own cache. Below, the requests cost more than
-#: they save (1e4 disks: 2% fewer collisions a second; 1e5: no gain that the noise shows).
+#: Slots from which the heap's sift down and the event loop ask for lines ahead (`_prefetch_below`,
+#: `_prefetch_following`): the heap's keys and items, 3 MB, then outgrow a core's own cache.
+#: Below, the requests cost more than they save (1e4 disks: 2% fewer collisions a second; 1e5: no
+#: gain that the noise shows, and a loss on a quiet machine).
 PREFETCH_FROM = 1 << 18
-
-#: Slots from which each event asks for what the next two will read first (`_prefetch_following`):
-#: the engine's 6 MB then outgrow what the shared cache keeps of it. Measured in collisions a second
-#: (W1, one thread): 5-10% fewer at 4e4 disks, about 10% more at 1e5, -3% to +9% a round at 1e6.
-PREFETCH_EVENTS_FROM = 1 << 16
 
 #: Event codes below 0: a crossing into the neighbouring cell in direction d (0 -x, 1 +x, 2 -y,
 #: 3 +y) is ``-1 - d``; contact c with the vessel (`collidium.kernels.vessels.contacts`: the
@@ -149,6 +147,13 @@ def _slot_views(event):
 #: Events per particle between two re-sorts of the slots by cell (sorting costs about as much as
 #: one event per particle; neighbours drift apart in memory over tens of events).
 SORT_INTERVAL = 16
+
+#: Cells along a side of the square tiles in whose order `sort_slots` puts the slots (cells in
+#: rows within a tile). A disk's neighbours in the rows of cells above and below then mostly lie
+#: within a few hundred bytes of its own row, not a whole row of cells away: W1 at 1e6 disks
+#: (ARCHITECTURE.md, "The exact engine's steps in one call") ran 2-8% faster than with rows of
+#: cells (a tile of 1).
+TILE = 4
 
 
 @inlined
@@ -294,9 +299,8 @@ def _prefetch_below(first, keys, items) -> None:
 
 @inlined
 def _prefetch_following(keys, items, body, event, head, grid) -> None:
-    """Ask ahead for what the next two events will read first, in a heap of
-    `PREFETCH_EVENTS_FROM` slots or more, where each line would otherwise come only when an
-    event waits for it.
+    """Ask ahead for what the next two events will read first, in a heap of `PREFETCH_FROM`
+    slots or more, where each line would otherwise come only when an event waits for it.
 
     The next event is most likely the earliest of the root's children's, and the one after the
     earliest of that child's children and its siblings (a million disks' events are so close in
@@ -304,7 +308,7 @@ def _prefetch_following(keys, items, body, event, head, grid) -> None:
     one's, asked for at the event before, have mostly come, so ask for the cell heads of the three
     rows of cells around it too, which its prediction reads first.
     """
-    if keys.shape[0] >= PREFETCH_EVENTS_FROM:
+    if keys.shape[0] >= PREFETCH_FROM:
         near, _ = _least_of_eight(keys, 1)
         following = items[near]
         prefetch(body, (following, 0))
@@ -708,9 +712,26 @@ def _swap_rows(array, a, b) -> None:
         array[a, column], array[b, column] = array[b, column], array[a, column]
 
 
+@inlined
+def _starts_by_tile(head, ncx) -> None:
+    """Turn the count of slots in each cell (``head``, cells ``x + ncx * y``) into the first new
+    slot of each: the cells taken tile by tile (`TILE`), both row by row."""
+    ncy = head.shape[0] // ncx
+    start = 0
+    for ty in range(0, ncy, TILE):
+        for tx in range(0, ncx, TILE):
+            for cy in range(ty, min(ty + TILE, ncy)):
+                for cx in range(tx, min(tx + TILE, ncx)):
+                    c = cx + ncx * cy
+                    size = head[c]
+                    head[c] = start
+                    start += size
+
+
 @uncounted()
-def sort_slots(body, cell_of, event, head, next_, items, where) -> None:
-    """Renumber the slots in cell order (a counting sort), keeping every reference consistent.
+def sort_slots(body, cell_of, event, head, next_, items, where, grid) -> None:
+    """Renumber the slots in cell order, tile by tile (`TILE`; a counting sort), keeping every
+    reference consistent.
 
     ``head`` doubles as the counting array and ``next_`` as each slot's new number before both
     are rebuilt.
@@ -719,11 +740,7 @@ def sort_slots(body, cell_of, event, head, next_, items, where) -> None:
     head[:] = 0
     for k in range(n):
         head[cell_of[k]] += 1
-    start = 0
-    for c in range(head.shape[0]):
-        size = head[c]
-        head[c] = start
-        start += size
+    _starts_by_tile(head, grid[0])
     moved_to = next_
     for k in range(n):  # stable: slots keep their relative order within a cell
         c = cell_of[k]
@@ -759,7 +776,7 @@ def rebuild(now, body, geometry, grid, head, next_, event, keys, items, segments
     """
     n = body.shape[0]
     _restart_between(0, n, now, body, geometry, grid, event, items)
-    _sort_restarted(body, event, head, next_, items)
+    _sort_restarted(body, event, head, next_, items, grid)
     _predict_between(0, n, now, body, geometry, grid, head, next_, event, keys, segments, piston)
     _heap_build(keys, items, event[:, WHERE])
 
@@ -775,7 +792,7 @@ def rebuild_near(now, body, geometry, grid, head, next_, event, keys, items, seg
     around it then, as after any contact."""
     n = body.shape[0]
     _restart_between(0, n, now, body, geometry, grid, event, items)
-    _sort_restarted(body, event, head, next_, items)
+    _sort_restarted(body, event, head, next_, items, grid)
     ident, cell_of, count = event[:, IDENT], event[:, CELL], event[:, COUNT]
     for k in range(n):
         if near[ident[k]]:
@@ -814,7 +831,7 @@ def rebuild_in_chunks(
     for p in numba.prange(chunks):
         _restart_between(p * n // chunks, (p + 1) * n // chunks, now, body, geometry, grid,
                          event, items)  # fmt: skip
-    _sort_restarted(body, event, head, next_, items)
+    _sort_restarted(body, event, head, next_, items, grid)
     for p in numba.prange(chunks):
         _predict_between(p * n // chunks, (p + 1) * n // chunks, now, body, geometry, grid, head,
                          next_, event, keys, segments, piston)  # fmt: skip
@@ -839,10 +856,10 @@ def _restart_between(start, stop, now, body, geometry, grid, event, items) -> No
 
 
 @inlined
-def _sort_restarted(body, event, head, next_, items) -> None:
+def _sort_restarted(body, event, head, next_, items, grid) -> None:
     """`sort_slots` after `_restart_between`. The slots keep the order of the queue before
     (`load`), sorted by the cells of a little earlier, so few rows move."""
-    sort_slots(body, event[:, CELL], event, head, next_, items, event[:, WHERE])
+    sort_slots(body, event[:, CELL], event, head, next_, items, event[:, WHERE], grid)
 
 
 @inlined
@@ -936,7 +953,7 @@ def run_events(
     since_sort = 0
     while True:
         if since_sort >= sort_every:
-            sort_slots(body, cell_of, event, head, next_, items, where)
+            sort_slots(body, cell_of, event, head, next_, items, where, grid)
             since_sort = 0
         t = keys[0]
         if piston.shape[0] > 0 and piston[pistons.NEXT] < t:
