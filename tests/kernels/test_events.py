@@ -266,8 +266,9 @@ def _tile_rank(cell: np.ndarray, ncx: int) -> np.ndarray:
 
 
 def test_sorting_slots_moves_every_reference_with_its_particle(rng):
-    """`sort_slots` permutes rows in place along cycles: afterwards the slots are in cell order,
-    and every row, partner, cell list and heap entry still belongs to the same particle."""
+    """`sort_slots` permutes rows in place along cycles: afterwards the slots are in the order of
+    their cells tile by tile (`_tile_rank`), and every row, partner, cell list and heap entry
+    still belongs to the same particle."""
     sim = _dense_gas("periodic", rng)
     sim._drift.sort_interval = 10**9  # never: the slots drift out of cell order
     sim.run(steps=1)
