@@ -188,10 +188,11 @@ def test_slot_order_does_not_change_the_outcome(rng, boundary):
 
 @pytest.mark.slow
 def test_a_heap_large_enough_to_prefetch_takes_the_same_events_in_any_slot_order():
-    """From `events.PREFETCH_FROM` disks the event loop and the heap's sift down ask for lines
-    ahead (`_prefetch_following`, `_prefetch_below`): reading where they guess the next events'
-    slots lie, they change nothing of the run, which is the same bit for bit with the slots
-    sorted by cell every event per particle or never."""
+    """From `events.PREFETCH_FROM` disks both the event loop and the heap's sift down ask for
+    lines ahead (`_prefetch_following`, from `events.PREFETCH_EVENTS_FROM`, and
+    `_prefetch_below`): reading where they guess the next events' slots and partners lie, they
+    change nothing of the run, which is the same bit for bit with the slots sorted by cell every
+    event per particle or never."""
     n = events.PREFETCH_FROM
     side = int(np.ceil(np.sqrt(n)))
     runs = []

@@ -111,11 +111,23 @@ LOG_COLUMNS = 17
 #: third as deep as a binary one.
 ARITY = 8
 
-#: Slots from which the heap's sift down and the event loop ask for lines ahead (`_prefetch_below`,
-#: `_prefetch_following`): the heap's keys and items, 3 MB, then outgrow a core's own cache.
-#: Below, the requests cost more than they save (1e4 disks: 2% fewer collisions a second; 1e5: no
-#: gain that the noise shows, and a loss on a quiet machine).
+#: Slots from which the heap's sift down asks for the lines of the level below ahead
+#: (`_prefetch_below`): the heap's keys and items, 3 MB, then outgrow a core's own cache. Below,
+#: the requests cost more than they save (1e4 disks: 2% fewer collisions a second; 1e5: no gain
+#: that the noise shows).
 PREFETCH_FROM = 1 << 18
+
+#: Slots from which the event loop asks ahead for what the next events read
+#: (`_prefetch_following`): the engine's rows, 4.5 MB at 2^16 disks, then lie outside a core's
+#: own cache. With other programs sharing the machine's cache, 1e5 disks ran 7-77% more
+#: collisions a second than with the requests from 2^18 (six rounds); 4e4 disks from 16% fewer to
+#: 5% more, so not there.
+PREFETCH_EVENTS_FROM = 1 << 16
+
+#: Slots on either side of the next event's whose ``body`` rows the event loop asks for ahead
+#: (`_prefetch_following`): with the slots sorted by cell in tiles (`TILE`), most of a disk's
+#: neighbours lie there.
+ROWS_AROUND = 4
 
 #: Event codes below 0: a crossing into the neighbouring cell in direction d (0 -x, 1 +x, 2 -y,
 #: 3 +y) is ``-1 - d``; contact c with the vessel (`collidium.kernels.vessels.contacts`: the
@@ -298,17 +310,20 @@ def _prefetch_below(first, keys, items) -> None:
 
 
 @inlined
-def _prefetch_following(keys, items, body, event, head, grid) -> None:
-    """Ask ahead for what the next two events will read first, in a heap of `PREFETCH_FROM`
-    slots or more, where each line would otherwise come only when an event waits for it.
+def _prefetch_following(keys, items, body, event, head, next_, grid) -> None:
+    """Ask ahead for what the next two events will read first, in a heap of
+    `PREFETCH_EVENTS_FROM` slots or more, where each line would otherwise come only when an event
+    waits for it.
 
     The next event is most likely the earliest of the root's children's, and the one after the
-    earliest of that child's children and its siblings (a million disks' events are so close in
-    time that one predicted meanwhile rarely comes between). Ask for the rows of both; the next
-    one's, asked for at the event before, have mostly come, so ask for the cell heads of the three
-    rows of cells around it too, which its prediction reads first.
+    earliest of that child's children and its siblings (a large gas's events are so close in time
+    that one predicted meanwhile rarely comes between). Ask for the rows of both. The next
+    one's, asked for at the event before, have mostly come; so ask for what its predictions read
+    too: the cell heads of the three rows of cells around it, the ``body`` rows of the slots
+    within `ROWS_AROUND` of its own (the slots are sorted by cell, so there lie most of its
+    neighbours), its line of ``next_``, and its partner's rows, if its event is a contact.
     """
-    if keys.shape[0] >= PREFETCH_FROM:
+    if keys.shape[0] >= PREFETCH_EVENTS_FROM:
         near, _ = _least_of_eight(keys, 1)
         following = items[near]
         prefetch(body, (following, 0))
@@ -321,6 +336,14 @@ def _prefetch_following(keys, items, body, event, head, grid) -> None:
         last = head.shape[0] - 1
         for row in (c - ncx - 1, c - 1, c + ncx - 1):
             prefetch(head, min(max(row, 0), last))
+        n = body.shape[0]
+        for slot in range(max(following - ROWS_AROUND, 0), min(following + ROWS_AROUND + 1, n)):
+            prefetch(body, (slot, 0))
+        prefetch(next_, following)
+        partner = event[following, CODE]
+        if partner >= 0:
+            prefetch(body, (partner, 0))
+            prefetch(event, (partner, 0))
 
 
 @inlined
@@ -968,7 +991,7 @@ def run_events(
         if t > until:
             break
         k = earliest(keys, items, ident)
-        _prefetch_following(keys, items, body, event, head, grid)
+        _prefetch_following(keys, items, body, event, head, next_, grid)
         processed += 1
         since_sort += 1
         if t > instant:
