@@ -321,7 +321,9 @@ def _prefetch_following(keys, items, body, event, head, next_, grid) -> None:
     one's, asked for at the event before, have mostly come; so ask for what its predictions read
     too: the cell heads of the three rows of cells around it, the ``body`` rows of the slots
     within `ROWS_AROUND` of its own (the slots are sorted by cell, so there lie most of its
-    neighbours), its line of ``next_``, and its partner's rows, if its event is a contact.
+    neighbours), its line of ``next_``, and its partner's rows, if its event is a contact, or the
+    heads of the three cells that come into reach, if it crosses into the next row of cells (its
+    prediction then searches them; in the next column they are mostly on the lines asked for).
     """
     if keys.shape[0] >= PREFETCH_EVENTS_FROM:
         near, _ = _least_of_eight(keys, 1)
@@ -340,10 +342,14 @@ def _prefetch_following(keys, items, body, event, head, next_, grid) -> None:
         for slot in range(max(following - ROWS_AROUND, 0), min(following + ROWS_AROUND + 1, n)):
             prefetch(body, (slot, 0))
         prefetch(next_, following)
-        partner = event[following, CODE]
-        if partner >= 0:
-            prefetch(body, (partner, 0))
-            prefetch(event, (partner, 0))
+        code = event[following, CODE]
+        if code >= 0:  # a contact: its partner's rows
+            prefetch(body, (code, 0))
+            prefetch(event, (code, 0))
+        elif code == -3 or code == -4:  # into the row of cells below or above (`CELL_CODES`)
+            beyond = c + (2 * ncx if code == -4 else -2 * ncx)
+            prefetch(head, min(max(beyond - 1, 0), last))
+            prefetch(head, min(max(beyond + 1, 0), last))
 
 
 @inlined
