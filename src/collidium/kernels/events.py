@@ -335,9 +335,8 @@ def _prefetch_following(keys, items, body, event, head, next_, grid) -> None:
         prefetch(event, (after, 0))
         c = event[following, CELL]
         ncx = grid[0]
-        last = head.shape[0] - 1
         for row in (c - ncx - 1, c - 1, c + ncx - 1):
-            prefetch(head, min(max(row, 0), last))
+            _prefetch_head(head, row)
         n = body.shape[0]
         for slot in range(max(following - ROWS_AROUND, 0), min(following + ROWS_AROUND + 1, n)):
             prefetch(body, (slot, 0))
@@ -346,10 +345,17 @@ def _prefetch_following(keys, items, body, event, head, next_, grid) -> None:
         if code >= 0:  # a contact: its partner's rows
             prefetch(body, (code, 0))
             prefetch(event, (code, 0))
-        elif code == -3 or code == -4:  # into the row of cells below or above (`CELL_CODES`)
-            beyond = c + (2 * ncx if code == -4 else -2 * ncx)
-            prefetch(head, min(max(beyond - 1, 0), last))
-            prefetch(head, min(max(beyond + 1, 0), last))
+        elif CELL_CODES[1] <= code and (-1 - code) // 2 == 1:  # a crossing along y
+            beyond = c + (2 * ncx if (-1 - code) % 2 == 1 else -2 * ncx)
+            _prefetch_head(head, beyond - 1)
+            _prefetch_head(head, beyond + 1)
+
+
+@inlined
+def _prefetch_head(head, cell) -> None:
+    """Ask for the line of ``head`` holding ``cell``'s entry, the index clamped to the grid (a
+    guess past its edge asks for a line that is of no use, never for one outside it)."""
+    prefetch(head, min(max(cell, 0), head.shape[0] - 1))
 
 
 @inlined
