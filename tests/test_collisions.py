@@ -8,7 +8,7 @@ import pytest
 
 import collidium as cd
 from collidium.collisions import ExactCollisions, Tally, _free_flight, make_drift
-from collidium.kernels import cells, events
+from collidium.kernels import cells, event_queue, events
 
 
 def _engine(sim: cd.Simulation) -> ExactCollisions:
@@ -152,17 +152,22 @@ def test_engine_grid_takes_small_cells_in_a_small_scene_without_gravity_or_segme
     assert cells.EVENT_CELLS_PER_PARTICLE * (most > 3) < per_disk <= most
 
 
-def test_engine_takes_84_bytes_per_disk_of_one_radius_and_mass_plus_4_per_cell():
+def test_engine_takes_68_bytes_per_disk_of_one_radius_and_mass_its_queue_and_4_per_cell():
     """The layout that lets a million disks run in 300 MB (`kernels/events.py`): body rows of
-    40 bytes, 28 bytes of integers, heap keys 8 and items 4, cell lists 4 per disk and per cell;
-    four arrays get up to 64 bytes more to start on a cache line."""
+    40 bytes, 24 bytes of integers, cell lists 4 per disk and per cell, and the event queue
+    (`kernels/event_queue.py`), under 9 bytes a disk; four arrays get up to 64 bytes more to
+    start on a cache line."""
     sim = cd.load("gas", n=1000, radius=0.1, seed=3).run(steps=2)
     s = _engine(sim)._state
     assert s is not None
     owners = {id(a): a for a in (x if x.base is None else x.base for x in s.values())}
     allocated = sum(a.nbytes for a in owners.values())
-    expected = 84 * sim.particles.n + 4 * s["head"].size + s["geometry"].nbytes + s["grid"].nbytes
-    assert expected <= allocated <= expected + 4 * 64
+    queue = s["keys"].nbytes + s["items"].nbytes
+    expected = 68 * sim.particles.n + queue + 4 * s["head"].size
+    assert expected + s["geometry"].nbytes + s["grid"].nbytes <= allocated
+    assert allocated <= expected + s["geometry"].nbytes + s["grid"].nbytes + 4 * 64
+    times, slots = event_queue.sizes(10**6)
+    assert 8 * times + 4 * slots < 9 * 10**6
 
 
 def test_queue_saved_in_an_earlier_layout_is_rebuilt_not_misread():

@@ -22,7 +22,7 @@ from typing import Literal, Protocol
 import numpy as np
 
 from collidium.errors import SimulationError
-from collidium.kernels import audit, event_flights, events, stepper
+from collidium.kernels import audit, event_flights, event_queue, events, stepper
 from collidium.kernels.cells import (
     WINDOW_FROM,
     bounding_box,
@@ -893,20 +893,18 @@ def _piston_now(piston: FloatArray, t: float) -> FloatArray:
     return np.array([sign * height, sign * speed])
 
 
-def _cache_aligned_rows(
-    n: int, columns: int, dtype: type = np.float64, first: int = 0
-) -> np.ndarray:
-    """An empty (n, columns) array whose row ``first`` starts on a 64-byte cache line, and so
-    every row after it if the row size divides 64.
+def _cache_aligned_rows(n: int, columns: int, dtype: type = np.float64) -> np.ndarray:
+    """An empty (n, columns) array that starts on a 64-byte cache line, and so every row if the
+    row size divides 64.
 
-    The engine reads a neighbour as one row, and the heap a node's children as one group from
-    index 1 on; large arrays come from the allocator 16 bytes past a line, and a row or group
-    would then span two lines.
+    The engine reads a neighbour as one row, and the event queue a block or a heap node's
+    children as one group (`collidium.kernels.event_queue`); large arrays come from the allocator
+    16 bytes past a line, and a row or group would then span two lines.
     """
     itemsize = np.dtype(dtype).itemsize
     per_line = 64 // itemsize
     buffer: np.ndarray = np.empty(n * columns + per_line, dtype=dtype)
-    skip = (-(buffer.ctypes.data + first * columns * itemsize) % 64) // itemsize
+    skip = (-buffer.ctypes.data % 64) // itemsize
     return buffer[skip : skip + n * columns].reshape(n, columns)
 
 
@@ -923,12 +921,13 @@ def _engine_arrays(n: int, cells: int, columns: int = events.BODY_COLUMNS) -> di
     """Empty engine arrays for n particles and a grid of ``cells`` (all but geometry and grid),
     with ``body`` rows of ``columns`` (`events.BODY_COLUMNS` or `events.SHARED_BODY_COLUMNS`).
 
-    A slot's integers share one 28-byte row of ``event``: ``ident``, ``cell_of``, ``count`` and
-    ``where`` are views of its last columns, so the engine reads a slot in two rows (its ``body``
-    row and this one).
+    A slot's integers share one 24-byte row of ``event``: ``ident``, ``cell_of`` and ``count``
+    are views of its last columns, so the engine reads a slot in two rows (its ``body`` row and
+    this one). ``keys`` and ``items`` hold the event queue (`collidium.kernels.event_queue`).
     """
     index = np.int32
     rows = _cache_aligned_rows(n, events.SLOT_COLUMNS, index)
+    times, slots = event_queue.sizes(n)
     views = {name: rows[:, column] for name, column in _SLOT_VIEWS.items()}
     views["ident"][...] = np.arange(n)  # slot k holds particle k until the first sort
     return {
@@ -936,8 +935,8 @@ def _engine_arrays(n: int, cells: int, columns: int = events.BODY_COLUMNS) -> di
         "head": np.empty(cells, dtype=index),
         "next": np.empty(n, dtype=index),
         "event": rows,
-        "keys": _cache_aligned_rows(n, 1, first=1)[:, 0],
-        "items": _cache_aligned_rows(n, 1, index, first=1)[:, 0],
+        "keys": _cache_aligned_rows(times, 1)[:, 0],
+        "items": _cache_aligned_rows(slots, 1, index)[:, 0],
     } | views
 
 
@@ -961,13 +960,14 @@ def _restored(saved: dict[str, np.ndarray]) -> dict[str, np.ndarray] | None:
 
 #: The layout of the engine's saved queues (2: walls after the cell crossings, any number of
 #: them; 3: the pairs' restitution in ``geometry``; 4: the cells' window there too; 5: and the
-#: gravity the disks fall with); a queue saved with another is rebuilt, not read.
-_EVENT_CODES = 5
+#: gravity the disks fall with; 6: the queue of blocks, `collidium.kernels.event_queue`); a queue
+#: saved with another is rebuilt, not read.
+_EVENT_CODES = 6
 
 
 #: The engine's arrays that are views of columns of ``event`` (`_engine_arrays`).
 _SLOT_VIEWS = {
-    "ident": events.IDENT, "cell_of": events.CELL, "count": events.COUNT, "where": events.WHERE,
+    "ident": events.IDENT, "cell_of": events.CELL, "count": events.COUNT,
 }  # fmt: skip
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_event_queue import earliest_slot
 
 from collidium import Box, Circle, Gravity, Particles, Simulation, collisions, load
 from collidium.kernels import audit, cells, events, reference
@@ -17,23 +18,6 @@ def test_contact_delay_head_on():
     assert contact_delay(2.0, 0.0, -4.0, 0.0, 0.5) == pytest.approx(0.375, rel=1e-15)
     assert contact_delay(2.0, 0.0, 4.0, 0.0, 0.5) == np.inf  # separating
     assert contact_delay(2.0, 0.0, 0.0, 4.0, 0.5) == np.inf  # passing by
-
-
-@pytest.mark.parametrize("n", [1, 9, 73, 600])
-def test_queue_takes_events_in_time_then_ident_order(rng, n):
-    """The heap compares times only; among equal times `earliest` must still give the lowest
-    ident, wherever the tied entries sit in the heap."""
-    keys = rng.choice([1.0, 2.0, 3.0], n)  # many ties at every depth
-    ident = rng.permutation(n).astype(np.int32)
-    heap_keys = keys.copy()
-    items, where = (np.empty(n, dtype=np.int32) for _ in range(2))
-    events._heap_build(heap_keys, items, where)
-    taken = []
-    for _ in range(n):
-        k = events.earliest(heap_keys, items, ident)
-        taken.append(k)
-        events.heap_update(k, np.inf, heap_keys, items, where)
-    assert taken == np.lexsort((ident, keys)).tolist()
 
 
 @pytest.mark.parametrize(
@@ -187,13 +171,12 @@ def test_slot_order_does_not_change_the_outcome(rng, boundary):
 
 
 @pytest.mark.slow
-def test_a_heap_large_enough_to_prefetch_takes_the_same_events_in_any_slot_order():
-    """From `events.PREFETCH_FROM` disks both the event loop and the heap's sift down ask for
-    lines ahead (`_prefetch_following`, from `events.PREFETCH_EVENTS_FROM`, and
-    `_prefetch_below`): reading where they guess the next events' slots and partners lie, they
-    change nothing of the run, which is the same bit for bit with the slots sorted by cell every
-    event per particle or never."""
-    n = events.PREFETCH_FROM
+def test_a_gas_large_enough_to_prefetch_takes_the_same_events_in_any_slot_order():
+    """From `events.PREFETCH_EVENTS_FROM` disks the event loop asks for lines ahead
+    (`_prefetch_following`): reading where it guesses the next events' slots and partners lie,
+    it changes nothing of the run, which is the same bit for bit with the slots sorted by cell
+    every event per particle or never."""
+    n = events.PREFETCH_EVENTS_FROM
     side = int(np.ceil(np.sqrt(n)))
     runs = []
     for interval in (1, 10**9):
@@ -227,7 +210,7 @@ def _by_particle(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         "kept": partner[events.KEPT],
         "cell": state["cell_of"][order],
         "count": state["count"][order],
-        "time": state["keys"][state["where"][order]],
+        "time": state["keys"][order],  # the queue's first entries: the slots' times
     }
 
 
@@ -268,8 +251,8 @@ def _tile_rank(cell: np.ndarray, ncx: int) -> np.ndarray:
 
 def test_sorting_slots_moves_every_reference_with_its_particle(rng):
     """`sort_slots` permutes rows in place along cycles: afterwards the slots are in the order of
-    their cells tile by tile (`_tile_rank`), and every row, partner, cell list and heap entry
-    still belongs to the same particle."""
+    their cells tile by tile (`_tile_rank`), every row, partner, cell list and event time still
+    belongs to the same particle, and the queue takes the earliest event first."""
     sim = _dense_gas("periodic", rng)
     sim._drift.sort_interval = 10**9  # never: the slots drift out of cell order
     sim.run(steps=1)
@@ -278,13 +261,15 @@ def test_sorting_slots_moves_every_reference_with_its_particle(rng):
     assert np.any(np.diff(_tile_rank(state["cell_of"], state["grid"][0])) < 0)
     events.sort_slots(
         state["body"], state["cell_of"], state["event"], state["head"], state["next"],
-        state["items"], state["where"], state["grid"],
+        state["keys"], state["items"], state["grid"],
     )  # fmt: skip
     assert np.all(np.diff(_tile_rank(state["cell_of"], state["grid"][0])) >= 0)
     after = _by_particle(state)
     for name in before:
         np.testing.assert_array_equal(after[name], before[name], err_msg=name)
-    np.testing.assert_array_equal(state["items"][state["where"]], np.arange(sim.particles.n))
+    times = state["keys"][: sim.particles.n]
+    first = np.lexsort((state["ident"], times))[0]
+    assert earliest_slot(state["keys"], state["items"], state["ident"]) == first
     members = np.full(sim.particles.n, -1)
     for cell, first in enumerate(state["head"]):
         k = first
@@ -436,7 +421,7 @@ def test_the_parallel_rebuild_builds_the_queue_the_serial_one_does(rng):
         rebuild(sim.time, *collisions._queue(s, sim.container))
         built.append(s)
     serial, parallel = built
-    assert np.isfinite(serial["keys"]).all()
+    assert np.isfinite(serial["keys"][: p.n]).all()
     for name in collisions._QUEUE_ARRAYS:
         np.testing.assert_array_equal(serial[name], parallel[name], err_msg=name)
 

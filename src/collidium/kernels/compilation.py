@@ -126,9 +126,8 @@ def interrupts_outside_compiling() -> Iterator[None]:
 def _prefetch(typingctx: Any, array: Any, index: Any) -> Any:
     """Ask the processor for the cache line of ``array[index]`` (an index within the array, a
     tuple of them for an array of more dimensions), to be read soon: LLVM's ``llvm.prefetch``,
-    which changes nothing else. A chain of loads that
-    each wait for the one before (the heap's levels, `collidium.kernels.events`) can then ask for
-    the next level's lines while the compares of this one run."""
+    which changes nothing else. The event loop (`collidium.kernels.events`) asks so for what the
+    next events will read while this one runs."""
     signature = types.void(array, index)
 
     def codegen(context: Any, builder: Any, sig: Any, args: Any) -> Any:

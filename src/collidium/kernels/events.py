@@ -4,7 +4,7 @@ inelastic with a normal restitution).
 Design (Rapaport; Donev, Torquato & Stillinger; Bannerman's DynamO for the memory layout):
 
 - Each particle keeps one next event: a pair contact, a wall contact or a crossing into the next
-  cell of the grid. An 8-ary heap orders particles by that event time.
+  cell of the grid. The event queue (`collidium.kernels.event_queue`) gives the earliest.
 - Positions are lazy: a particle's row holds where it was at its own time stamp; at time t it is
   at ``x + v (t - stamp)``, or under a uniform gravity ``g`` that every disk shares on the
   parabola ``x + v tau + g tau^2 / 2``, moving at ``v + g tau`` (``tau = t - stamp``). A pair's
@@ -34,13 +34,13 @@ Memory layout. At 1e5 particles and more the engine waits on memory, not arithme
   bytes (`SHARED_BODY_COLUMNS`): smaller rows mean more collisions per second at N = 1e5.
 - An event is one int32 code: the partner's slot (>= 0), a wall (`FIRST_WALL_CODE`) or a cell
   crossing (`CELL_CODES`); indices are int32. The caller keeps all of a slot's integers in one
-  28-byte row (`SLOT_COLUMNS`), so a slot is two rows.
-- The heap's children of a node fill one cache line. In a large heap each level of a sift down
-  asks for the next level's lines ahead (`_prefetch_below`), and each event for what the next
-  two will read first (`_prefetch_following`). The kernels are compiled without numba's
-  reference counting (`_engine`).
-- Memory: about 94 bytes per disk of one radius and mass at packing 0.3 (``body`` 40, integers
-  28, heap 12, cell lists 14), so a million disks fit in 300 MB with the interpreter and LLVM.
+  24-byte row (`SLOT_COLUMNS`), so a slot is two rows.
+- The queue keeps each slot's time in slot order, and the earliest of blocks of them, so that
+  what an event's new time updates is known from its slot alone. Each event asks for what the
+  next two will read first (`_prefetch_following`). The kernels are compiled without numba's
+  reference counting (`collidium.kernels.compilation.uncounted`).
+- Memory: about 87 bytes per disk of one radius and mass at packing 0.3 (``body`` 40, integers
+  24, queue 9, cell lists 14), so a million disks fit in 300 MB with the interpreter and LLVM.
   So the contact kept for the short prediction after a crossing (`predict`) is its partner
   alone, 4 bytes, and its time is computed again when needed: storing it too would add 8.
 
@@ -55,7 +55,7 @@ import math
 import numba
 import numpy as np
 
-from collidium.kernels import parabolas, wall_responses
+from collidium.kernels import event_queue, parabolas, wall_responses
 from collidium.kernels.audit import fails_in_box
 from collidium.kernels.cells import cell_index, neighbour_cell
 from collidium.kernels.collision import bounce_factor, energy_change, pair_response
@@ -87,12 +87,12 @@ GEOMETRY_SIZE = 14
 CODE, KEPT, PARTNER_COUNT = range(3)
 EVENT_COLUMNS = 3
 
-#: Columns after the event's in the rows the caller allocates, so that one 28-byte row holds
+#: Columns after the event's in the rows the caller allocates, so that one 24-byte row holds
 #: every integer of a slot (a slot's state is then two rows): the arrays ``ident``,
-#: ``cell_of``, ``count`` and ``where`` that the kernels take must be views of these columns,
-#: as `sort_slots` moves whole rows.
-IDENT, CELL, COUNT, WHERE = range(EVENT_COLUMNS, EVENT_COLUMNS + 4)
-SLOT_COLUMNS = EVENT_COLUMNS + 4
+#: ``cell_of`` and ``count`` that the kernels take must be views of these columns, as
+#: `sort_slots` moves whole rows.
+IDENT, CELL, COUNT = range(EVENT_COLUMNS, EVENT_COLUMNS + 3)
+SLOT_COLUMNS = EVENT_COLUMNS + 3
 
 #: Columns of the contact log that `run_events` writes in a drift under forces: the particle, its
 #: partner (or ``-1 - wall``, `collidium.vessels.Vessel.wall_names` order), the time (s), the
@@ -106,16 +106,6 @@ LOG_PARTICLE, LOG_PARTNER, LOG_TIME, LOG_NX, LOG_NY, LOG_BOUNCE, LOG_DVX, LOG_DV
 #: accelerations at it (4, m/s^2), and the contact's jump of the modified energy (J).
 LOG_ERROR, LOG_PULL, LOG_DROP = 8, 12, 16
 LOG_COLUMNS = 17
-
-#: Children per node of the event queue's heap: 8 keys fill one 64-byte line, and the heap is a
-#: third as deep as a binary one.
-ARITY = 8
-
-#: Slots from which the heap's sift down asks for the lines of the level below ahead
-#: (`_prefetch_below`): the heap's keys and items, 3 MB, then outgrow a core's own cache. Below,
-#: the requests cost more than they save (1e4 disks: 2% fewer collisions a second; 1e5: no gain
-#: that the noise shows).
-PREFETCH_FROM = 1 << 18
 
 #: Slots from which the event loop asks ahead for what the next events read
 #: (`_prefetch_following`): the engine's rows, 4.5 MB at 2^16 disks, then lie outside a core's
@@ -147,13 +137,13 @@ CONTACT_SLACK = 1e-12
 
 @inlined
 def _slot_views(event):
-    """The slots' particles, cells, event counts and heap places: columns of ``event``, (N,).
+    """The slots' particles, cells and event counts: columns of ``event``, (N,).
 
     The engine's entry points take these views here, from ``event``, rather than as arguments:
     a lone disk's column would be contiguous, another array type to numba, and so another
     minute-long compilation of the whole engine.
     """
-    return event[:, IDENT], event[:, CELL], event[:, COUNT], event[:, WHERE]
+    return event[:, IDENT], event[:, CELL], event[:, COUNT]
 
 
 #: Events per particle between two re-sorts of the slots by cell (sorting costs about as much as
@@ -238,113 +228,44 @@ def contact_delay(
     return gap / (-b + math.sqrt(disc))
 
 
-# --- the event queue: an ARITY-ary heap of slots keyed by event time ------------------------------
-#
-# The heap compares times only (branch-free minimum of the children, several times faster than
-# comparing (time, ident) pairs); equal times are ordered by ident when the next event is taken
-# (`earliest`), so the order of events is still the total order (time, ident).
+# --- asking ahead ---------------------------------------------------------------------------------
 
 
 @inlined
-def _sift_up(slot, key, item, keys, items, where) -> int:
-    """Move ``(key, item)`` up from ``slot`` to its place; return where it landed."""
-    while slot > 0:
-        parent = (slot - 1) // ARITY
-        above = keys[parent]
-        if above <= key:
-            break
-        keys[slot] = above
-        moved = items[parent]
-        items[slot] = moved
-        where[moved] = slot
-        slot = parent
-    keys[slot] = key
-    items[slot] = item
-    where[item] = slot
-    return slot
+def _prefetch_following(queue, body, event, head, next_, grid) -> None:
+    """Ask ahead for what the next two events will read first, from `PREFETCH_EVENTS_FROM` slots
+    on, where each line would otherwise come only when an event waits for it.
 
-
-@inlined
-def _sift_down(slot, key, item, keys, items, where) -> None:
-    """Move ``(key, item)`` down from ``slot`` to its place."""
-    n = keys.shape[0]
-    while True:
-        first = ARITY * slot + 1
-        if first >= n:
-            break
-        if ARITY == 8 and first + ARITY <= n:  # a constant: the test is compiled away
-            _prefetch_below(first, keys, items)
-            child, least = _least_of_eight(keys, first)
-        else:
-            child = first
-            least = keys[first]
-            for c in range(first + 1, n):
-                if keys[c] < least:
-                    child = c
-                    least = keys[c]
-        if key <= least:
-            break
-        keys[slot] = least
-        moved = items[child]
-        items[slot] = moved
-        where[moved] = slot
-        slot = child
-    keys[slot] = key
-    items[slot] = item
-    where[item] = slot
-
-
-@inlined
-def _prefetch_below(first, keys, items) -> None:
-    """Ask for the lines of the children of the ``ARITY`` nodes from ``first`` (keys and items),
-    before their least is known, in a heap of `PREFETCH_FROM` slots or more: at a million disks
-    the sift down waited on each level's lines in turn; asked for ahead, they come while the
-    level above is compared."""
-    n = keys.shape[0]
-    if n < PREFETCH_FROM:
-        return
-    below = ARITY * first + 1
-    for node in range(below, min(below + ARITY * ARITY, n), ARITY):
-        prefetch(keys, node)
-        prefetch(items, node)
-
-
-@inlined
-def _prefetch_following(keys, items, body, event, head, next_, grid) -> None:
-    """Ask ahead for what the next two events will read first, in a heap of
-    `PREFETCH_EVENTS_FROM` slots or more, where each line would otherwise come only when an event
-    waits for it.
-
-    The next event is most likely the earliest of the root's children's, and the one after the
-    earliest of that child's children and its siblings (a large gas's events are so close in time
-    that one predicted meanwhile rarely comes between). Ask for the rows of both. The next
-    one's, asked for at the event before, have mostly come; so ask for what its predictions read
-    too: the cell heads of the three rows of cells around it, the ``body`` rows of the slots
-    within `ROWS_AROUND` of its own (the slots are sorted by cell, so there lie most of its
-    neighbours), its line of ``next_``, and its partner's rows, if its event is a contact, or the
-    heads of the three cells that come into reach, if it crosses into the next row of cells (its
-    prediction then searches them; in the next column they are mostly on the lines asked for).
+    The queue tells which slots most likely come next and after it
+    (`collidium.kernels.event_queue.likely_next`). Ask for the rows of both. The next one's,
+    asked for at the event before, have mostly come; so ask for what its event reads too: the
+    cell heads of the three rows of cells around it, the ``body`` rows of the slots within
+    `ROWS_AROUND` of its own (the slots are sorted by cell, so there lie most of its neighbours),
+    its line of ``next_``, the queue's lines its new time updates, and its partner's rows and
+    queue lines, if its event is a contact, or the heads of the three cells that come into reach,
+    if it crosses into the next row of cells (its prediction then searches them; in the next
+    column they are mostly on the lines asked for).
     """
-    if keys.shape[0] >= PREFETCH_EVENTS_FROM:
-        near, _ = _least_of_eight(keys, 1)
-        following = items[near]
+    n = body.shape[0]
+    if n >= PREFETCH_EVENTS_FROM:
+        following, after = event_queue.likely_next(queue)
         prefetch(body, (following, 0))
         prefetch(event, (following, 0))
-        after = items[_second_least(keys, near)]
         prefetch(body, (after, 0))
         prefetch(event, (after, 0))
         c = event[following, CELL]
         ncx = grid[0]
         for row in (c - ncx - 1, c - 1, c + ncx - 1):
             _prefetch_head(head, row)
-        n = body.shape[0]
         for slot in range(max(following - ROWS_AROUND, 0), min(following + ROWS_AROUND + 1, n)):
             prefetch(body, (slot, 0))
         prefetch(next_, following)
+        event_queue.prefetch_lines(following, queue)
         code = event[following, CODE]
         if code >= 0:  # a contact: its partner's rows
             prefetch(body, (code, 0))
             prefetch(event, (code, 0))
+            event_queue.prefetch_lines(code, queue)
         elif CELL_CODES[1] <= code and (-1 - code) // 2 == 1:  # a crossing along y
             beyond = c + (2 * ncx if (-1 - code) % 2 == 1 else -2 * ncx)
             _prefetch_head(head, beyond - 1)
@@ -356,107 +277,6 @@ def _prefetch_head(head, cell) -> None:
     """Ask for the line of ``head`` holding ``cell``'s entry, the index clamped to the grid (a
     guess past its edge asks for a line that is of no use, never for one outside it)."""
     prefetch(head, min(max(cell, 0), head.shape[0] - 1))
-
-
-@inlined
-def _second_least(keys, near) -> int:
-    """Place of the earliest key among the root's children but ``near`` (their earliest) and
-    ``near``'s own children, where the heap's second least lies: the event most likely to come
-    after the next. The heap must be three levels deep."""
-    second, least = _least_of_eight(keys, ARITY * near + 1)
-    for s in range(1, ARITY + 1):
-        earlier = s != near and keys[s] < least
-        least = keys[s] if earlier else least
-        second = s if earlier else second
-    return second
-
-
-@inlined
-def _least(a, b, ia, ib):
-    """The lesser of keys a and b with its index (ia, ib); a on a tie. Selects, not branches."""
-    later = b < a
-    return (b if later else a), (ib if later else ia)
-
-
-@inlined
-def _least_of_eight(keys, first):
-    """``(index, key)`` of the least of ``keys[first:first + 8]``, the first on a tie: a
-    tournament of pairs, three compares deep rather than seven in a row, without branches (which
-    way the minimum goes is a coin toss, and a mispredicted branch costs more than the
-    compares)."""
-    v01, i01 = _least(keys[first], keys[first + 1], 0, 1)
-    v23, i23 = _least(keys[first + 2], keys[first + 3], 2, 3)
-    v45, i45 = _least(keys[first + 4], keys[first + 5], 4, 5)
-    v67, i67 = _least(keys[first + 6], keys[first + 7], 6, 7)
-    v03, i03 = _least(v01, v23, i01, i23)
-    v47, i47 = _least(v45, v67, i45, i67)
-    v, i = _least(v03, v47, i03, i47)
-    return first + i, v
-
-
-@inlined
-def heap_update(k, key, keys, items, where) -> None:
-    """Give slot k the event time ``key`` (s) and restore heap order (O(log N))."""
-    slot = where[k]
-    if _sift_up(slot, key, k, keys, items, where) == slot:
-        _sift_down(slot, key, k, keys, items, where)
-
-
-@uncounted()
-def _earliest_tied(keys, items, ident) -> int:
-    """Among the entries whose time equals the root's, the slot with the lowest ident.
-
-    Heap order puts every such entry in a subtree at the root (its ancestors can be neither later
-    nor earlier), so the search goes down level by level through the span of children of the
-    tied entries found on the level above.
-    """
-    n = keys.shape[0]
-    tied = keys[0]
-    best = items[0]
-    lo = hi = 0
-    while ARITY * lo + 1 < n:
-        found_lo = found_hi = -1
-        for c in range(ARITY * lo + 1, min(ARITY * hi + ARITY + 1, n)):
-            if keys[c] == tied:
-                if ident[items[c]] < ident[best]:
-                    best = items[c]
-                if found_lo < 0:
-                    found_lo = c
-                found_hi = c
-        if found_lo < 0:
-            break
-        lo, hi = found_lo, found_hi
-    return best
-
-
-@inlined
-def earliest(keys, items, ident) -> int:
-    """The slot whose event comes first in the order (time, ident): the root's, unless one of
-    its children ties with it (none is earlier), which their least tells without a branch each."""
-    if ARITY == 8 and keys.shape[0] > ARITY:
-        tied = _least_of_eight(keys, 1)[1] == keys[0]
-    else:
-        tied = False
-        for c in range(1, keys.shape[0]):
-            tied |= keys[c] == keys[0]
-    return _earliest_tied(keys, items, ident) if tied else items[0]
-
-
-@uncounted()
-def _heap_build(keys, items, where) -> None:
-    """Order a heap whose ``keys[s]`` belong to slot ``s`` (O(N))."""
-    n = keys.shape[0]
-    for s in range(n):
-        items[s] = s
-        where[s] = s
-    _heapify(keys, items, where)
-
-
-@uncounted()
-def _heapify(keys, items, where) -> None:
-    """Restore heap order to ``keys`` and ``items`` as they lie, ``where`` kept (O(N))."""
-    for s in range((keys.shape[0] - 2) // ARITY, -1, -1):
-        _sift_down(s, keys[s], items[s], keys, items, where)
 
 
 # --- predictions --------------------------------------------------------------------------------
@@ -764,9 +584,18 @@ def _starts_by_tile(head, ncx) -> None:
 
 
 @uncounted()
-def sort_slots(body, cell_of, event, head, next_, items, where, grid) -> None:
+def sort_slots(body, cell_of, event, head, next_, keys, items, grid) -> None:
     """Renumber the slots in cell order, tile by tile (`TILE`; a counting sort), keeping every
-    reference consistent.
+    reference consistent, and order the queue (``keys``, ``items``:
+    `collidium.kernels.event_queue`) again."""
+    _sort_rows(body, cell_of, event, head, next_, keys, grid)
+    event_queue.build(keys, items, event[:, IDENT])
+
+
+@inlined
+def _sort_rows(body, cell_of, event, head, next_, keys, grid) -> None:
+    """`sort_slots` but for the queue's order: the slots' rows and times (the first entries of
+    ``keys``) are moved.
 
     ``head`` doubles as the counting array and ``next_`` as each slot's new number before both
     are rebuilt.
@@ -786,8 +615,6 @@ def sort_slots(body, cell_of, event, head, next_, items, where, grid) -> None:
         for column in (CODE, KEPT):
             if event[k, column] >= 0:
                 event[k, column] = moved_to[event[k, column]]
-    for s in range(n):
-        items[s] = moved_to[items[s]]
     # ... then the rows, in place along the cycles of the permutation: each swap puts the row
     # at ``first`` in its place.
     for first in range(n):
@@ -795,10 +622,9 @@ def sort_slots(body, cell_of, event, head, next_, items, where, grid) -> None:
             to = moved_to[first]
             _swap_rows(body, first, to)
             _swap_rows(event, first, to)
+            keys[first], keys[to] = keys[to], keys[first]
             moved_to[first] = moved_to[to]
             moved_to[to] = to
-    for s in range(n):
-        where[items[s]] = s
     _link_cells(cell_of, head, next_)
 
 
@@ -810,10 +636,10 @@ def rebuild(now, body, geometry, grid, head, next_, event, keys, items, segments
     this sets the stamps, sorts the slots by cell and predicts every event.
     """
     n = body.shape[0]
-    _restart_between(0, n, now, body, geometry, grid, event, items)
-    _sort_restarted(body, event, head, next_, items, grid)
+    _restart_between(0, n, now, body, geometry, grid, event)
+    _sort_restarted(body, event, head, next_, keys, grid)
     _predict_between(0, n, now, body, geometry, grid, head, next_, event, keys, segments, piston)
-    _heap_build(keys, items, event[:, WHERE])
+    event_queue.build(keys, items, event[:, IDENT])
 
 
 @uncounted()
@@ -826,8 +652,8 @@ def rebuild_near(now, body, geometry, grid, head, next_, event, keys, items, seg
     the same: a disk that meets one of them after a contact of its own searches the cells
     around it then, as after any contact."""
     n = body.shape[0]
-    _restart_between(0, n, now, body, geometry, grid, event, items)
-    _sort_restarted(body, event, head, next_, items, grid)
+    _restart_between(0, n, now, body, geometry, grid, event)
+    _sort_restarted(body, event, head, next_, keys, grid)
     ident, cell_of, count = event[:, IDENT], event[:, CELL], event[:, COUNT]
     for k in range(n):
         if near[ident[k]]:
@@ -836,7 +662,7 @@ def rebuild_near(now, body, geometry, grid, head, next_, event, keys, items, seg
         else:
             keys[k] = _predict_alone(k, now, body, geometry, grid, cell_of, event, segments,
                                      piston)  # fmt: skip
-    _heap_build(keys, items, event[:, WHERE])
+    event_queue.build(keys, items, ident)
 
 
 @inlined
@@ -865,18 +691,18 @@ def rebuild_in_chunks(
     chunks = chunk_count(n)
     for p in numba.prange(chunks):
         _restart_between(p * n // chunks, (p + 1) * n // chunks, now, body, geometry, grid,
-                         event, items)  # fmt: skip
-    _sort_restarted(body, event, head, next_, items, grid)
+                         event)  # fmt: skip
+    _sort_restarted(body, event, head, next_, keys, grid)
     for p in numba.prange(chunks):
         _predict_between(p * n // chunks, (p + 1) * n // chunks, now, body, geometry, grid, head,
                          next_, event, keys, segments, piston)  # fmt: skip
-    _heap_build(keys, items, event[:, WHERE])
+    event_queue.build(keys, items, event[:, IDENT])
 
 
 @inlined
-def _restart_between(start, stop, now, body, geometry, grid, event, items) -> None:
+def _restart_between(start, stop, now, body, geometry, grid, event) -> None:
     """Stamp the slots ``start`` to ``stop - 1`` at ``now`` (s), find their cells and forget their
-    events and collision counts (``items`` gets each slot, for `sort_slots` to renumber)."""
+    events and collision counts."""
     ncx = grid[0]
     for k in range(start, stop):
         body[k, STAMP] = now
@@ -887,20 +713,21 @@ def _restart_between(start, stop, now, body, geometry, grid, event, items) -> No
         event[k, CODE] = NO_EVENT
         event[k, KEPT] = -1
         event[k, PARTNER_COUNT] = 0
-        items[k] = k
 
 
 @inlined
-def _sort_restarted(body, event, head, next_, items, grid) -> None:
-    """`sort_slots` after `_restart_between`. The slots keep the order of the queue before
-    (`load`), sorted by the cells of a little earlier, so few rows move."""
-    sort_slots(body, event[:, CELL], event, head, next_, items, event[:, WHERE], grid)
+def _sort_restarted(body, event, head, next_, keys, grid) -> None:
+    """`sort_slots` after `_restart_between`, but for the queue, which has no times yet. The
+    slots keep the order of the queue before (`load`), sorted by the cells of a little earlier,
+    so few rows move."""
+    _sort_rows(body, event[:, CELL], event, head, next_, keys, grid)
 
 
 @inlined
 def _predict_between(start, stop, now, body, geometry, grid, head, next_, event, keys, segments,
                      piston) -> None:  # fmt: skip
-    """Predict the events of the slots ``start`` to ``stop - 1`` into ``event`` and ``keys``."""
+    """Predict the events of the slots ``start`` to ``stop - 1`` into ``event`` and their times
+    into ``keys`` (the queue's first entries, `collidium.kernels.event_queue`)."""
     ident, cell_of, count = event[:, IDENT], event[:, CELL], event[:, COUNT]
     for k in range(start, stop):
         keys[k] = _predict_not_inlined(k, now, body, ident, geometry, grid, cell_of, head, next_,
@@ -978,7 +805,8 @@ def run_events(
         if time stopped advancing at particle i: far more events at one instant than simultaneous
         contacts allow, which only a runaway state (huge or infinite velocities) produces.
     """
-    ident, cell_of, count, where = _slot_views(event)
+    ident, cell_of, count = _slot_views(event)
+    queue = event_queue.views(keys, items)
     processed = 0
     n = body.shape[0]
     if n == 0:
@@ -988,22 +816,22 @@ def run_events(
     since_sort = 0
     while True:
         if since_sort >= sort_every:
-            sort_slots(body, cell_of, event, head, next_, items, where, grid)
+            sort_slots(body, cell_of, event, head, next_, keys, items, grid)
             since_sort = 0
-        t = keys[0]
+        t = event_queue.first_time(queue)
         if piston.shape[0] > 0 and piston[pistons.NEXT] < t:
             # The piston reaches an end of its travel first.
             if piston[pistons.NEXT] > until:
                 break
             pistons.arrive(piston)
             _piston_moved(piston[pistons.STAMP], body, ident, geometry, grid, cell_of, head,
-                          next_, count, event, keys, items, where, segments, piston)  # fmt: skip
+                          next_, count, event, queue, segments, piston)  # fmt: skip
             processed += 1
             continue
         if t > until:
             break
-        k = earliest(keys, items, ident)
-        _prefetch_following(keys, items, body, event, head, next_, grid)
+        k = event_queue.earliest(queue, ident)
+        _prefetch_following(queue, body, event, head, next_, grid)
         processed += 1
         since_sort += 1
         if t > instant:
@@ -1025,7 +853,7 @@ def run_events(
                 # Not the literal -1, which numba would compile a second `predict` for.
                 t_j = predict(j, t, np.int64(-1), body, ident, geometry, grid, cell_of, head, next_,
                               count, event, segments, piston)  # fmt: skip
-                heap_update(j, t_j, keys, items, where)
+                event_queue.update(j, t_j, queue, ident)
         elif piston.shape[0] > 0 and code == FIRST_WALL_CODE - piston[pistons.WALL]:
             old_x, old_y = body[k, VX], body[k, VY]
             _push_piston(k, t, body, ident, geometry, tally, impulse, heat, piston)
@@ -1044,10 +872,10 @@ def run_events(
             _cross_cell(k, crossed, body, ident, image, geometry, grid, cell_of, head, next_)
         t_k = predict(k, t, crossed, body, ident, geometry, grid, cell_of, head, next_, count,
                       event, segments, piston)  # fmt: skip
-        heap_update(k, t_k, keys, items, where)
+        event_queue.update(k, t_k, queue, ident)
         if pushed:
             _piston_moved(t, body, ident, geometry, grid, cell_of, head, next_, count, event,
-                          keys, items, where, segments, piston)  # fmt: skip
+                          queue, segments, piston)  # fmt: skip
     return processed
 
 
@@ -1073,8 +901,8 @@ def _push_piston(k, t, body, ident, geometry, tally, impulse, heat, piston):
 
 
 @uncounted()
-def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count, event, keys,
-                  items, where, segments, piston) -> None:  # fmt: skip
+def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count, event, queue,
+                  segments, piston) -> None:  # fmt: skip
     """The piston's path changed at time ``now`` (s): every disk whose next event was a contact
     with it is predicted again, and every other that now meets it sooner than its next event
     takes that contact. O(N) per change of the piston's path, a few ns per disk."""
@@ -1083,14 +911,14 @@ def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count,
         if event[k, CODE] == code:
             t_k = _predict_not_inlined(k, now, body, ident, geometry, grid, cell_of, head, next_,
                                        count, event, segments, piston)  # fmt: skip
-            heap_update(k, t_k, keys, items, where)
+            event_queue.update(k, t_k, queue, ident)
             continue
         x, y, vx, vy = _at(k, now, body, geometry)
         when = now + pistons.delay(piston, now, x, y, vx, vy, _radius(k, body, geometry),
                                    geometry[FALL_X], geometry[FALL_Y])  # fmt: skip
-        if when < keys[where[k]]:
+        if when < queue[0][k]:
             event[k, CODE] = code
-            heap_update(k, when, keys, items, where)
+            event_queue.update(k, when, queue, ident)
 
 
 @inlined
@@ -1371,8 +1199,8 @@ def refresh(now, body, geometry, grid, head, next_, event, keys, items, segments
 
     That is exact, as after a collision: the changed slot's collision count goes up, so that
     events predicted against it are stale when they come, and its own prediction searches every
-    neighbour, so that it finds any contact that comes before their own next events. The heap is
-    then ordered again (`_predict_marked_between`).
+    neighbour, so that it finds any contact that comes before their own next events. The queue is
+    then ordered again (`collidium.kernels.event_queue.build`).
 
     Parameters
     ----------
@@ -1394,7 +1222,7 @@ def refresh(now, body, geometry, grid, head, next_, event, keys, items, segments
     if changed > 0:
         _predict_marked_between(0, n, now, body, geometry, grid, head, next_, event, keys,
                                 segments, piston)  # fmt: skip
-        _heapify(keys, items, event[:, WHERE])
+        event_queue.build(keys, items, event[:, IDENT])
     return changed
 
 
@@ -1417,7 +1245,7 @@ def refresh_in_chunks(now, body, geometry, grid, head, next_, event, keys, items
         for p in numba.prange(chunks):
             _predict_marked_between(p * n // chunks, (p + 1) * n // chunks, now, body, geometry,
                                     grid, head, next_, event, keys, segments, piston)  # fmt: skip
-        _heapify(keys, items, event[:, WHERE])
+        event_queue.build(keys, items, event[:, IDENT])
     return total
 
 
@@ -1458,13 +1286,9 @@ def _take_in_between(start, stop, now, body, event, geometry, position, velocity
 def _predict_marked_between(start, stop, now, body, geometry, grid, head, next_, event, keys,
                             segments, piston) -> None:  # fmt: skip
     """Predict the slots ``start`` to ``stop - 1`` marked `REPREDICT` again, each event time
-    written at the slot's place in the heap, whose order `_heapify` then restores: a pass over
-    the heap that stops at once where a node's children are not earlier. Moving each changed
-    slot to its place alone was cheaper only where fewer than a few hundred of 1e5 changed
-    (ARCHITECTURE.md, "A kick and the event queue")."""
-    ident, cell_of, count, where = _slot_views(event)
+    written into ``keys`` (the queue's first entries), whose order the caller then restores."""
+    ident, cell_of, count = _slot_views(event)
     for k in range(start, stop):
         if event[k, KEPT] == REPREDICT:
-            keys[where[k]] = _predict_not_inlined(k, now, body, ident, geometry, grid, cell_of,
-                                                  head, next_, count, event, segments,
-                                                  piston)  # fmt: skip
+            keys[k] = _predict_not_inlined(k, now, body, ident, geometry, grid, cell_of, head,
+                                           next_, count, event, segments, piston)  # fmt: skip
