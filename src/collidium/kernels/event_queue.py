@@ -57,7 +57,10 @@ def sizes(n: int) -> tuple[int, int]:
 @inlined
 def views(keys, items):
     """The queue's parts: ``times``, ``block_times``, ``heap_times`` (float64) and
-    ``block_slots``, ``heap_slots``, ``places`` (int32), views of ``keys`` and ``items``."""
+    ``block_slots``, ``heap_slots``, ``places`` (int32), views of ``keys`` and ``items``.
+
+    Only for kernels compiled without reference counting (`uncounted`), as the engine's are: a
+    kernel that counts references would release views it never held."""
     slots = (keys.shape[0] - _KEYS_GAP) // (SUPER + BLOCK + 1) * SUPER
     blocks, supers = slots // BLOCK, slots // SUPER
     heap = slots + blocks + _KEYS_GAP - 1
@@ -111,8 +114,8 @@ def _least_of_block(values, first):
 @uncounted()
 def _tied_slot(values, first, slots, ident):
     """The slot of lowest ident among the equal least of ``values[first:first + BLOCK]``, where
-    entry c is slot ``slots[c]``, or slot c where ``slots`` is None. Padding slots (past
-    ``ident``'s) come last."""
+    entry c is slot ``slots[c]``, or slot c where ``slots`` is empty (one type either way: one
+    compilation). Padding slots (past ``ident``'s) come last."""
     least = values[first]
     for c in range(first + 1, first + BLOCK):
         least = min(least, values[c])
@@ -120,17 +123,17 @@ def _tied_slot(values, first, slots, ident):
     best = -1
     for c in range(first, first + BLOCK):
         if values[c] == least:
-            s = c if slots is None else slots[c]
+            s = c if slots.shape[0] == 0 else slots[c]
             if best < 0 or (s < n and (best >= n or ident[s] < ident[best])):
                 best = s
     return best
 
 
 @inlined
-def _block_earliest(b, times, ident):
+def _block_earliest(b, times, block_slots, ident):
     """``(time, slot)`` of block b's earliest event."""
     i, v, equal = _least_of_block(times, b * BLOCK)
-    return v, (i if equal == 1 else _tied_slot(times, b * BLOCK, None, ident))
+    return v, (i if equal == 1 else _tied_slot(times, b * BLOCK, block_slots[:0], ident))
 
 
 @inlined
@@ -258,7 +261,7 @@ def update(k, t, queue, ident) -> None:
     b = k // BLOCK
     held = block_slots[b]
     if k == held:
-        when, slot = _block_earliest(b, times, ident)
+        when, slot = _block_earliest(b, times, block_slots, ident)
     elif t < block_times[b] or (t == block_times[b] and ident[k] < ident[held]):
         when, slot = t, k
     else:
@@ -282,7 +285,7 @@ def build(keys, items, ident) -> None:
     times, block_times, heap_times, block_slots, heap_slots, places = views(keys, items)
     times[ident.shape[0] :] = math.inf
     for b in range(block_times.shape[0]):
-        block_times[b], block_slots[b] = _block_earliest(b, times, ident)
+        block_times[b], block_slots[b] = _block_earliest(b, times, block_slots, ident)
     for s in range(heap_times.shape[0]):
         heap_times[s], heap_slots[s] = _super_earliest(s, block_times, block_slots, ident)
         places[s] = s
