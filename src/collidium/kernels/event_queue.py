@@ -236,7 +236,7 @@ def earliest(queue, ident) -> int:
     """The slot whose event comes first in the order (time, ident) (``queue``: `views`): the
     heap root's, unless one of its children ties with it (none is earlier), which their least
     tells without a branch each."""
-    heap_times, heap_slots = queue[2], queue[4]
+    _, _, heap_times, _, heap_slots, _ = queue
     if heap_times.shape[0] > ARITY:
         tied = least_of_eight(heap_times, 1)[1] == heap_times[0]
     else:
@@ -249,7 +249,15 @@ def earliest(queue, ident) -> int:
 @inlined
 def first_time(queue) -> float:
     """The earliest event time in the queue (s)."""
-    return queue[2][0]
+    _, _, heap_times, _, _, _ = queue
+    return heap_times[0]
+
+
+@inlined
+def time_of(k, queue) -> float:
+    """Slot k's event time (s)."""
+    times, _, _, _, _, _ = queue
+    return times[k]
 
 
 @inlined
@@ -299,7 +307,7 @@ def likely_next(queue):
     root's children's, and the earliest of that child's children's and its siblings'. A large
     gas's events are so close in time that one predicted meanwhile rarely comes between. The
     heap must be three levels deep."""
-    heap_times, heap_slots = queue[2], queue[4]
+    _, _, heap_times, _, heap_slots, _ = queue
     near, _ = least_of_eight(heap_times, 1)
     second, least = least_of_eight(heap_times, ARITY * near + 1)
     for s in range(1, ARITY + 1):

@@ -916,7 +916,7 @@ def _piston_moved(now, body, ident, geometry, grid, cell_of, head, next_, count,
         x, y, vx, vy = _at(k, now, body, geometry)
         when = now + pistons.delay(piston, now, x, y, vx, vy, _radius(k, body, geometry),
                                    geometry[FALL_X], geometry[FALL_Y])  # fmt: skip
-        if when < queue[0][k]:
+        if when < event_queue.time_of(k, queue):
             event[k, CODE] = code
             event_queue.update(k, when, queue, ident)
 
