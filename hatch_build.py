@@ -8,13 +8,14 @@ missing or older than a source, so a wheel built from an sdist needs no Node.js.
 clone needs Node.js (>= 18) and npm; ``COLLIDIUM_SKIP_FRONTEND=1`` builds without the viewer
 (``collidium view`` then says the front end is missing).
 
-A wheel (not an editable install) also carries numba's cache of the kernels that the presets
-run (``python -m collidium.precompile``, run on a copy of the package in the build's
-environment, which holds collidium's dependencies for it), so that the first run after ``pip
-install .`` loads them instead of compiling them. numba keys its cache by the source's content,
-its own version and the CPU, so a wheel used elsewhere, or with another numba, compiles on its
-first run as without it. The compiled copy stays in ``build/kernels/`` for the next build from
-the same sources. ``COLLIDIUM_PRECOMPILE=0`` builds without it (a wheel to publish).
+A wheel (not an editable install) also carries numba's cache of the kernels that the presets run
+(``python -m collidium.precompile``, run on a copy of the package in the build's environment, which
+holds collidium's dependencies for it), so that the first run after ``pip install .`` loads them
+instead of compiling them. Their cache is stamped with the content of every kernel's source
+(``collidium.kernels.compilation``), numba's version and the CPU, so a wheel used elsewhere, or
+with another numba, compiles on its first run as without it. The compiled copy stays in
+``build/kernels/`` for the next build from the same sources. ``COLLIDIUM_PRECOMPILE=0`` builds
+without it (a wheel to publish).
 """
 
 from __future__ import annotations

@@ -5,8 +5,13 @@ from __future__ import annotations
 
 import importlib
 import inspect
+import os
 import pkgutil
+import shutil
 import signal
+import subprocess
+import sys
+from pathlib import Path
 from typing import Any
 
 import numba
@@ -16,7 +21,12 @@ from numba.core import event as numba_event
 from numba.core.registry import CPUDispatcher as Dispatcher
 
 import collidium.kernels
-from collidium.kernels.compilation import interrupts_outside_compiling, on_first_compile, prefetch
+from collidium.kernels.compilation import (
+    interrupts_outside_compiling,
+    kernel_sources_digest,
+    on_first_compile,
+    prefetch,
+)
 
 
 def _fresh_kernel():
@@ -76,6 +86,43 @@ def test_no_compile_no_call():
     with on_first_compile(lambda: calls.append(1)):
         kernel(2)
     assert calls == []
+
+
+#: A run of a small kernel in a copy of the package: where collidium came from, and how many
+#: times the kernel came from numba's cache.
+_CACHE_HITS = """
+import numpy as np
+import collidium
+from collidium.kernels.sums import kinetic_energy
+kinetic_energy(np.ones(3), np.ones((3, 2)))
+print(collidium.__file__, sum(kinetic_energy.stats.cache_hits.values()))
+"""
+
+
+def test_a_kernels_cache_is_used_until_any_kernel_changes(tmp_path):
+    """Each kernel's cache is stamped with every kernel's source: in a copy of the package, a
+    kernel compiled once is loaded from its cache, and compiled again after an edit (a comment)
+    of another kernel's file alone, which numba's own stamp, its file's content, misses. The copy's
+    stamp is the package's, whatever its place, as a wheel's compiled kernels need."""
+    shutil.copytree(Path(collidium.__file__).parent, tmp_path / "collidium",
+                    ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
+    kernels = tmp_path / "collidium" / "kernels"
+    assert kernel_sources_digest(kernels) == kernel_sources_digest()
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"} | {
+        "PYTHONPATH": str(tmp_path)
+    }
+
+    def hits() -> int:
+        result = subprocess.run([sys.executable, "-c", _CACHE_HITS], env=env, cwd=tmp_path,
+                                capture_output=True, text=True, check=True)  # fmt: skip
+        source, count = result.stdout.split()
+        assert Path(source).is_relative_to(tmp_path)
+        return int(count)
+
+    assert [hits(), hits()] == [0, 1]
+    with (kernels / "event_queue.py").open("a") as source:
+        source.write("# an edit of the event queue alone\n")
+    assert [hits(), hits()] == [0, 1]
 
 
 def _kernels() -> list[tuple[str, Any]]:

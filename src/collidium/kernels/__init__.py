@@ -5,6 +5,8 @@ Every kernel has a plain NumPy twin in `reference.py` that the tests compare aga
 
 import os
 
+from collidium.kernels.compilation import stamp_caches_with_every_kernel
+
 #: Spins a thread of numba's OpenMP pool (GNU's) waits for the next parallel loop before it
 #: sleeps. GNU's default, 300,000, keeps it spinning through the exact engine's serial events
 #: between the parallel passes of a step, a core busy for nothing (1.7 s of CPU in the 2.3 s of
@@ -14,3 +16,6 @@ import os
 OPENMP_SPINS = 10_000
 
 os.environ.setdefault("GOMP_SPINCOUNT", str(OPENMP_SPINS))
+
+# Before any kernel is decorated: each kernel's cache is stamped with every kernel's source.
+stamp_caches_with_every_kernel()

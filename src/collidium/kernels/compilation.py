@@ -5,22 +5,79 @@ numba announces each real compilation, and not a load from its cache, as a ``num
 event (its event API); `on_first_compile` turns the first such event into one call, so that a
 command line can say at once why nothing happens yet. `interrupts_outside_compiling` holds a
 Ctrl+C back while numba compiles or loads a kernel, which it cannot survive.
+
+numba stamps each kernel's cache with its own source file alone, yet a kernel's compiled code
+holds every kernel it calls, from other files too: after an edit of `events` alone, the cached
+substeps ran the event loop as it was, on arrays laid out as it is now (a crash). So
+`stamp_caches_with_every_kernel` stamps the caches of the kernels with every kernel's source.
 """
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import signal
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from types import FrameType
 from typing import Any
 
 import numba
 from llvmlite import ir
-from numba.core import cgutils, types
+from numba.core import caching, cgutils, types
 from numba.core import event as numba_event
 from numba.extending import intrinsic
+
+#: The kernels' package: the sources that every kernel's cache is stamped with.
+KERNELS = Path(__file__).resolve().parent
+
+
+@functools.cache
+def kernel_sources_digest(folder: Path = KERNELS) -> str:
+    """SHA-256 of every Python file under ``folder`` (the kernels' package), by path within it
+    and content: the same for a copy (a wheel's build, `collidium.precompile`), whatever its
+    place or files' times. Read once a process, as numba reads a kernel's own source."""
+    digest = hashlib.sha256()
+    for path in sorted(folder.rglob("*.py")):
+        digest.update(path.relative_to(folder).as_posix().encode() + b"\0")
+        digest.update(path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+def _stamped_with_every_kernel(locator: type) -> type:
+    """numba's cache ``locator`` (a class) for the kernels' files alone, their caches stamped
+    with `kernel_sources_digest` instead of their own file's content."""
+
+    class KernelsLocator(locator):
+        stamps_every_kernel = True
+
+        @classmethod
+        def from_function(cls, py_func: Any, py_file: str) -> Any:
+            if not Path(py_file).resolve().is_relative_to(KERNELS):
+                return None  # numba's own locators then serve it
+            return super().from_function(py_func, py_file)
+
+        def get_source_stamp(self) -> str:
+            return kernel_sources_digest()
+
+    KernelsLocator.__name__ = KernelsLocator.__qualname__ = f"Kernels{locator.__name__}"
+    return KernelsLocator
+
+
+def stamp_caches_with_every_kernel() -> None:
+    """Put, before numba's own, locators that stamp the kernels' caches with every kernel's
+    source (`kernel_sources_digest`): an edit of any kernel compiles them all again, and none
+    loads code compiled against another version of the kernels it calls. For the kernels
+    decorated after it (`collidium.kernels` calls it first); once is enough."""
+    named = vars(caching)
+    impl = named.get("CacheImpl") or named["_CacheImpl"]  # the older name
+    if any(getattr(cls, "stamps_every_kernel", False) for cls in impl._locator_classes):
+        return
+    ours = [_stamped_with_every_kernel(cls) for cls in impl._locator_classes
+            if issubclass(cls, caching._SourceFileBackedLocatorMixin)]  # fmt: skip
+    impl._locator_classes = [*ours, *impl._locator_classes]
 
 
 def uncounted(**options: Any) -> Any:
