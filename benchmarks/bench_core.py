@@ -32,6 +32,7 @@ import platform
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -77,14 +78,20 @@ def packed_gas(
 
 
 def exact_collisions_per_second(
-    n: int, target: float, repeats: int = 3, vessel: cd.vessels.Vessel | None = None
+    n: int,
+    target: float,
+    repeats: int = 3,
+    vessel: cd.vessels.Vessel | None = None,
+    warmed: Callable[[], None] = lambda: None,
 ) -> dict[str, Any]:
     """W1: time the exact engine (one thread) over about ``target`` pair collisions, ``repeats``
-    times in a row; the rate is the median (memory-bound timings vary from run to run)."""
+    times in a row; the rate is the median (memory-bound timings vary from run to run).
+    ``warmed`` is called between the warm-up and the timing (`bench_paired` waits there)."""
     sim = packed_gas(n, vessel=vessel)
     sim.dt = 0.2
     sim.run(steps=1)  # warm-up: compile, build the queue, relax the random start
     sim.dt = max(target / max(sim.counters.pair_collisions / 0.2, 1.0), 1e-3)
+    warmed()
     rates = []
     for _ in range(repeats):
         before = sim.counters.pair_collisions
