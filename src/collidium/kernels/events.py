@@ -241,8 +241,9 @@ def _prefetch_following(queue, body, event, head, next_, grid) -> None:
     asked for at the event before, have mostly come; so ask for what its event reads too: the
     cell heads of the three rows of cells around it, the ``body`` rows of the slots within
     `ROWS_AROUND` of its own (the slots are sorted by cell, so there lie most of its neighbours),
-    its line of ``next_``, the queue's lines its new time updates, and its partner's rows and
-    queue lines, if its event is a contact, or the heads of the three cells that come into reach,
+    its line of ``next_``, the queue's lines its new time updates, and its partner's rows, queue
+    lines and the rows within `ROWS_AROUND` of the partner's slot, if its event is a contact
+    (the partner is predicted again too), or the heads of the three cells that come into reach,
     if it crosses into the next row of cells (its prediction then searches them; in the next
     column they are mostly on the lines asked for).
     """
@@ -262,10 +263,12 @@ def _prefetch_following(queue, body, event, head, next_, grid) -> None:
         prefetch(next_, following)
         event_queue.prefetch_lines(following, queue)
         code = event[following, CODE]
-        if code >= 0:  # a contact: its partner's rows
+        if code >= 0:  # a contact: its partner's rows, and those around its slot
             prefetch(body, (code, 0))
             prefetch(event, (code, 0))
             event_queue.prefetch_lines(code, queue)
+            for slot in range(max(code - ROWS_AROUND, 0), min(code + ROWS_AROUND + 1, n)):
+                prefetch(body, (slot, 0))
         elif CELL_CODES[1] <= code and (-1 - code) // 2 == 1:  # a crossing along y
             beyond = c + (2 * ncx if (-1 - code) % 2 == 1 else -2 * ncx)
             _prefetch_head(head, beyond - 1)
