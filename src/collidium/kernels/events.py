@@ -258,8 +258,7 @@ def _prefetch_following(queue, body, event, head, next_, grid) -> None:
         ncx = grid[0]
         for row in (c - ncx - 1, c - 1, c + ncx - 1):
             _prefetch_head(head, row)
-        for slot in range(max(following - ROWS_AROUND, 0), min(following + ROWS_AROUND + 1, n)):
-            prefetch(body, (slot, 0))
+        _prefetch_rows_around(body, following)
         prefetch(next_, following)
         event_queue.prefetch_lines(following, queue)
         code = event[following, CODE]
@@ -267,12 +266,20 @@ def _prefetch_following(queue, body, event, head, next_, grid) -> None:
             prefetch(body, (code, 0))
             prefetch(event, (code, 0))
             event_queue.prefetch_lines(code, queue)
-            for slot in range(max(code - ROWS_AROUND, 0), min(code + ROWS_AROUND + 1, n)):
-                prefetch(body, (slot, 0))
+            _prefetch_rows_around(body, code)
         elif CELL_CODES[1] <= code and (-1 - code) // 2 == 1:  # a crossing along y
             beyond = c + (2 * ncx if (-1 - code) % 2 == 1 else -2 * ncx)
             _prefetch_head(head, beyond - 1)
             _prefetch_head(head, beyond + 1)
+
+
+@inlined
+def _prefetch_rows_around(body, slot) -> None:
+    """Ask for the ``body`` rows of the slots within `ROWS_AROUND` of ``slot``, its own again
+    among them (asked for first, with the lines that matter most): sorted by cell in tiles
+    (`TILE`), most of its neighbours lie there."""
+    for near in range(max(slot - ROWS_AROUND, 0), min(slot + ROWS_AROUND + 1, body.shape[0])):
+        prefetch(body, (near, 0))
 
 
 @inlined
