@@ -255,3 +255,15 @@ def test_step_mode_follows_disks_that_grow(shared, regrid):
     done, _ = reference.step_collisions(p.position, velocity, p.mass, p.radius)
     assert sim.tally.counts[0] - before == done > 10
     np.testing.assert_allclose(p.velocity, velocity, rtol=1e-13, atol=1e-13)
+
+
+def test_slots_are_sorted_more_often_in_a_gas_that_outgrows_the_caches():
+    """The engine re-sorts its slots every `events.SORT_INTERVAL` events a particle, every
+    `events.SORT_INTERVAL_LARGE` from `events.SORT_OFTEN_FROM` particles, unless told."""
+    drift = ExactCollisions()
+    below, at = events.SORT_OFTEN_FROM - 1, events.SORT_OFTEN_FROM
+    assert drift._sort_every(below) == events.SORT_INTERVAL * below
+    assert drift._sort_every(at) == events.SORT_INTERVAL_LARGE * at
+    assert events.SORT_INTERVAL_LARGE < events.SORT_INTERVAL
+    drift.sort_interval = 0  # every event
+    assert drift._sort_every(at) == 1

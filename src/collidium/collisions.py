@@ -574,8 +574,9 @@ class ExactCollisions:
         #: Times it was kept with the particles whose velocity changed predicted again, and how
         #: many such particles in all.
         self.refreshes = self.repredicted = 0
-        #: Events per particle between re-sorts of the engine's memory by cell (speed only).
-        self.sort_interval = events.SORT_INTERVAL
+        #: Events per particle between re-sorts of the engine's memory by cell (speed only);
+        #: None for `events.sort_interval`'s, by the number of particles.
+        self.sort_interval: int | None = None
         #: The contact log of drifts that are given none (never written: no forces).
         self._unlogged = ContactLog(0)
         #: Where a flight leaves the piston's face (`Tally.piston`'s two values).
@@ -715,7 +716,8 @@ class ExactCollisions:
 
     def _sort_every(self, n: int) -> int:
         """Events between re-sorts of the slots for n particles (`sort_interval` a particle)."""
-        return max(1, self.sort_interval * n)
+        interval = events.sort_interval(n) if self.sort_interval is None else self.sort_interval
+        return max(1, interval * n)
 
     def substep_engine(self, particles: Particles, vessel: Vessel) -> SubstepEngine | None:
         """An engine of its own for the compiled substeps' drifts that meet contacts

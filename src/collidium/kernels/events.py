@@ -150,6 +150,20 @@ def _slot_views(event):
 #: one event per particle; neighbours drift apart in memory over tens of events).
 SORT_INTERVAL = 16
 
+#: Slots from which the slots are re-sorted every `SORT_INTERVAL_LARGE` events a particle: in a
+#: gas that outgrows the caches, neighbours drifting apart in memory cost more than the sorts.
+#: W1 at 1e6 disks (`benchmarks/bench_paired.py`, eighteen rounds) ran a median 4% faster with 4
+#: than with 16, ahead in thirteen rounds; at 3e5 no faster, at 1e5 slower (ARCHITECTURE.md,
+#: "What an event at 1e6 disks is made of, and the designs measured by it").
+SORT_OFTEN_FROM = 1 << 19
+SORT_INTERVAL_LARGE = 4
+
+
+def sort_interval(n: int) -> int:
+    """Events per particle between two re-sorts of the slots of n disks."""
+    return SORT_INTERVAL_LARGE if n >= SORT_OFTEN_FROM else SORT_INTERVAL
+
+
 #: Cells along a side of the square tiles in whose order `sort_slots` puts the slots (cells in
 #: rows within a tile). A disk's neighbours in the rows of cells above and below then mostly lie
 #: within a few hundred bytes of its own row, not a whole row of cells away: W1 at 1e6 disks
